@@ -1,0 +1,70 @@
+"""Clauses of the robotics-oriented grammar (Section III-A of the paper).
+
+Toponyms are place names. Fixed points in the world (a sign or label tag, the
+start pose) are *anchors*, named ``#<tag id>`` or ``#start``; a place name can
+never start with ``#``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+ANCHOR_PREFIX = "#"
+START_ANCHOR = "#start"
+
+
+def tag_anchor(tag_id: int) -> str:
+    """The anchor name of a tag."""
+    return f"{ANCHOR_PREFIX}{tag_id}"
+
+
+def is_anchor(name: str) -> bool:
+    return name.startswith(ANCHOR_PREFIX)
+
+
+@dataclass(frozen=True)
+class Relational:
+    """``rel(preposition, figure, {referents}, context)``: the figure relative to the referents."""
+
+    preposition: str
+    figure: str
+    referents: tuple[str, ...]
+    context: str | None = None  # a toponym or an anchor; None when the cue gives none
+
+    def to_dict(self) -> dict[str, object]:
+        return {"type": "relational", "preposition": self.preposition, "figure": self.figure,
+                "referents": list(self.referents), "context": self.context}
+
+
+@dataclass(frozen=True)
+class Locational:
+    """``loc(toponym, W, x, y, r, theta)``: a place located from a fixed point in the world.
+
+    ``kind`` is "label" (the place lies behind the tag: ``direction`` is the tag's
+    normal plus pi) or "arrow" (the place lies in ``direction`` from the sign).
+    """
+
+    kind: str
+    toponym: str
+    anchor: str  # name of the fixed point, e.g. "#3"
+    direction: float  # rad, world frame, from the anchor to the place
+
+    def to_dict(self) -> dict[str, object]:
+        return {"type": "locational", "kind": self.kind, "toponym": self.toponym,
+                "anchor": self.anchor, "direction": self.direction}
+
+
+Clause = Relational | Locational
+
+
+def clause_from_dict(data: dict[str, object]) -> Clause:
+    """Inverse of ``to_dict`` for either clause type."""
+    if data.get("type") == "relational":
+        context = data["context"]
+        return Relational(str(data["preposition"]), str(data["figure"]),
+                          tuple(str(r) for r in data["referents"]),  # type: ignore[attr-defined]
+                          None if context is None else str(context))
+    if data.get("type") == "locational":
+        return Locational(str(data["kind"]), str(data["toponym"]), str(data["anchor"]),
+                          float(data["direction"]))  # type: ignore[arg-type]
+    raise ValueError(f"clause {data!r}: expected 'type' to be 'relational' or 'locational'")

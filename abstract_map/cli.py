@@ -1,0 +1,73 @@
+"""The ``abstract-map`` command.
+
+Subcommands are a registry: each names the module that defines it (an
+``add_arguments(parser)`` and a ``run(args) -> int``). The simulator's
+subcommands live in ``sim`` and are imported only when that package and its
+extra are installed, so the core works without them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+from types import ModuleType
+
+SUBCOMMANDS: dict[str, tuple[str, str]] = {
+    "imagine": ("abstract_map.imagine_command", "replay a scenario of cues and write the imagined map after each"),
+    "trial": ("sim.trial_command", "run one closed-loop trial in a pybullet world (needs the [sim] extra)"),
+    "study": ("sim.study_command", "run every goal of a world N times and compare with the paper (needs [sim])"),
+}
+
+
+class ExitError(Exception):
+    """An error for the user: printed as one line, exit code 2."""
+
+
+def _module(name: str) -> ModuleType | None:
+    try:
+        return importlib.import_module(SUBCOMMANDS[name][0])
+    except ModuleNotFoundError as exc:
+        if exc.name and (exc.name.startswith(("abstract_map", "sim")) and exc.name != SUBCOMMANDS[name][0]):
+            raise
+        return None
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="abstract-map",
+        description="Navigate unseen buildings from human signs and labels (Talbot et al. 2020).",
+    )
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name, (_, summary) in SUBCOMMANDS.items():
+        module = _module(name)
+        sub = subparsers.add_parser(name, help=summary, description=(module.__doc__ if module else summary),
+                                    formatter_class=argparse.RawDescriptionHelpFormatter)
+        if module is None:
+            sub.set_defaults(missing=name)
+        else:
+            module.add_arguments(sub)
+            sub.set_defaults(run=module.run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 2
+    if getattr(args, "missing", None):
+        print(f"abstract-map {args.missing}: the simulator is not installed; "
+              'install it with: pip install "abstract-map[sim]"', file=sys.stderr)
+        return 2
+    try:
+        return int(args.run(args))
+    except ExitError as exc:
+        print(f"abstract-map {args.command}: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

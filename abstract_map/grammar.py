@@ -1,0 +1,159 @@
+"""Parse cue text into clauses.
+
+A cue is either a label (its whole text names the place behind the tag) or a
+sign of one or more lines. Lines are separated by newlines or by the two
+characters backslash-n (as in the QUT cue mapping). A sign line is one of:
+
+- an arrow: ``$LEFT$ A, B and C`` (with or without a space after the arrow);
+- a phrase: ``[from CONTEXT,] FIGURES is|are PREPOSITION REFERENTS[, from CONTEXT]``,
+  where FIGURES and REFERENTS are lists joined by commas and "and", and the
+  referent "here" means the sign itself.
+
+Leading articles ("the", and a lower-case "a"/"an") are not part of a name.
+Anything that cannot be parsed raises :class:`CueError` naming the line.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+from .clauses import ANCHOR_PREFIX, Clause, Locational, Relational
+from .prepositions import ARROWS, HERE_WORDS, TABLE
+
+
+class CueError(ValueError):
+    """Cue text that the grammar cannot turn into clauses."""
+
+
+@dataclass(frozen=True)
+class Anchor:
+    """Where a cue was read: a fixed point with the direction its face points (rad, world)."""
+
+    name: str
+    x: float  # m
+    y: float  # m
+    theta: float  # rad
+
+    def __post_init__(self) -> None:
+        if not all(math.isfinite(v) for v in (self.x, self.y, self.theta)):
+            raise CueError(f"anchor {self.name!r}: pose ({self.x}, {self.y}, {self.theta}) must be finite")
+
+
+_ARROW = re.compile(r"^\$(?P<arrow>\w+)\$\s*(?P<names>.*)$")
+_LEADING_CONTEXT = re.compile(r"^from\s+(?P<context>[^,]+),\s*(?P<rest>.+)$", re.IGNORECASE)
+_TRAILING_CONTEXT = re.compile(r"^(?P<rest>.+?),\s*from\s+(?P<context>[^,]+)$", re.IGNORECASE)
+_COPULA = re.compile(r"^(?P<figures>.+?)\s+(?:is|are)\s+(?P<tail>.+)$", re.IGNORECASE)
+_PREPOSITION = re.compile(
+    r"^(?P<prep>" + "|".join(re.escape(w) for w in sorted(TABLE, key=len, reverse=True)) + r")\s+(?P<refs>.+)$",
+    re.IGNORECASE,
+)
+_LIST_SPLIT = re.compile(r"\s*,\s*(?:and\s+)?|\s+and\s+")
+_ARTICLE = re.compile(r"^(?:(?i:the)|a|an)\s+")
+
+
+def split_lines(text: str) -> list[str]:
+    """Lines of a cue: split on newlines and on the two characters backslash-n."""
+    return [line.strip() for line in text.replace("\\n", "\n").split("\n") if line.strip()]
+
+
+def clean_name(name: str, *, where: str) -> str:
+    """A place name without its leading article or trailing full stop."""
+    cleaned = _ARTICLE.sub("", name.strip().rstrip(".").strip()).strip()
+    if not cleaned:
+        raise CueError(f"{where}: empty place name")
+    if cleaned.startswith(ANCHOR_PREFIX):
+        raise CueError(f"{where}: place name {cleaned!r} may not start with {ANCHOR_PREFIX!r}")
+    return cleaned
+
+
+def split_names(text: str, *, where: str) -> list[str]:
+    """``"A, B and C"`` -> ``["A", "B", "C"]``."""
+    return [clean_name(part, where=where) for part in _LIST_SPLIT.split(text.strip()) if part.strip()]
+
+
+def parse_arrow(line: str, anchor: Anchor | None, *, where: str) -> list[Clause]:
+    """``$LEFT$ A, B`` -> one arrow clause per place, direction from the sign's pose."""
+    match = _ARROW.match(line)
+    if match is None:
+        raise CueError(f"{where}: not an arrow line")
+    arrow = match["arrow"].upper()
+    if arrow not in ARROWS:
+        raise CueError(f"{where}: unknown arrow ${match['arrow']}$; known arrows: {sorted(ARROWS)}")
+    if anchor is None:
+        raise CueError(f"{where}: an arrow needs the pose of the sign it is on")
+    names = split_names(match["names"], where=where)
+    if not names:
+        raise CueError(f"{where}: arrow ${arrow}$ points to no place")
+    direction = math.remainder(anchor.theta + ARROWS[arrow], math.tau)
+    return [Locational("arrow", name, anchor.name, direction) for name in names]
+
+
+def _resolve(name: str, anchor: Anchor | None, *, where: str) -> str:
+    if name.lower() in HERE_WORDS:
+        if anchor is None:
+            raise CueError(f"{where}: 'here' needs the pose of the sign it is on")
+        return anchor.name
+    return clean_name(name, where=where)
+
+
+def parse_phrase(line: str, anchor: Anchor | None, *, where: str) -> list[Clause]:
+    """``[from C,] X[, Y and Z] is|are PREP A[, B]`` -> one relational clause per figure."""
+    body, context = line.rstrip("."), None
+    for pattern in (_LEADING_CONTEXT, _TRAILING_CONTEXT):
+        match = pattern.match(body)
+        if match:
+            body, context = match["rest"], _resolve(match["context"], anchor, where=where)
+            break
+    copula = _COPULA.match(body)
+    if copula is None:
+        raise CueError(f"{where}: expected 'FIGURE is PREPOSITION REFERENT' or an arrow like '$LEFT$ Place'")
+    prep_match = _PREPOSITION.match(copula["tail"])
+    if prep_match is None:
+        word = copula["tail"].split()[0]
+        raise CueError(f"{where}: unknown preposition {word!r}; known prepositions: {sorted(TABLE)}")
+    preposition = prep_match["prep"].lower()
+    row = TABLE[preposition]
+    figures = [_resolve(f, anchor, where=where) for f in _LIST_SPLIT.split(copula["figures"]) if f.strip()]
+    referents = tuple(_resolve(r, anchor, where=where) for r in _LIST_SPLIT.split(prep_match["refs"]) if r.strip())
+    low, high = row.referents
+    if not low <= len(referents) <= high:
+        raise CueError(f"{where}: {preposition!r} takes {low} to {high} referents, got {len(referents)}")
+    if context is None and anchor is not None:
+        context = anchor.name
+    return [Relational(preposition, figure, referents, context) for figure in figures]
+
+
+def parse_line(line: str, anchor: Anchor | None, *, where: str = "cue") -> list[Clause]:
+    """One sign line (arrow or phrase) to clauses."""
+    line = line.strip()
+    if _ARROW.match(line):
+        return parse_arrow(line, anchor, where=where)
+    return parse_phrase(line, anchor, where=where)
+
+
+def looks_like_sign(text: str) -> bool:
+    """True if the text has several lines, an arrow or a phrase; False for a bare label."""
+    lines = split_lines(text)
+    return len(lines) != 1 or bool(_ARROW.match(lines[0]) or _COPULA.match(lines[0]))
+
+
+def parse_cue(text: str, anchor: Anchor | None = None, *, kind: str | None = None) -> list[Clause]:
+    """Clauses of a cue. ``kind`` is "label", "sign" or None (inferred from the text)."""
+    where_tag = f"cue at {anchor.name}" if anchor else "cue"
+    if not isinstance(text, str) or not text.strip():
+        raise CueError(f"{where_tag}: empty text")
+    if kind is None:
+        kind = "sign" if looks_like_sign(text) else "label"
+    if kind == "label":
+        if anchor is None:
+            raise CueError(f"{where_tag}: a label {text!r} needs the pose of its tag")
+        name = clean_name(text, where=f"{where_tag} label {text!r}")
+        return [Locational("label", name, anchor.name, math.remainder(anchor.theta + math.pi, math.tau))]
+    if kind != "sign":
+        raise CueError(f"{where_tag}: kind {kind!r} is not 'label' or 'sign'")
+    clauses: list[Clause] = []
+    for number, line in enumerate(split_lines(text), start=1):
+        clauses.extend(parse_line(line, anchor, where=f"{where_tag} line {number} {line!r}"))
+    return clauses

@@ -1,0 +1,63 @@
+"""Replay a scenario of cues and write the imagined map after each settle.
+
+Example:
+  abstract-map imagine worlds/zoo/lion_replay.json --out r.json --plot lion.png
+
+Writes {"steps": [{"settled", "iterations", "wall_s", "positions", "goal"}, ...]},
+the first entry being the model of the hierarchy alone. Prints one progress
+line per step and the median settle time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+from pathlib import Path
+from typing import Any
+
+from .cli import ExitError
+from .grammar import CueError
+from .hierarchy import HierarchyError
+from .model import UnknownPlaceError
+from .scenario import ScenarioError, load_scenario, replay
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("scenario", type=Path, help="scenario JSON (hierarchy, start, optional goal, steps)")
+    parser.add_argument("--out", type=Path, required=True, help="where to write the result JSON")
+    parser.add_argument("--plot", type=Path, help="also draw the final imagined map to this PNG")
+    parser.add_argument("--save-model", type=Path, help="also save the final model (versioned JSON)")
+    parser.add_argument("--quiet", action="store_true", help="no progress lines")
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        scenario = load_scenario(args.scenario)
+
+        def progress(i: int, n: int, record: dict[str, Any]) -> None:
+            if not args.quiet:
+                goal = "" if record["goal"] is None else " goal ({:.2f}, {:.2f})".format(*record["goal"])
+                state = "settled" if record["settled"] else "NOT settled"
+                print(f"[{i}/{n}] {record['cue']}: {state} in {record['iterations']} steps, "
+                      f"{record['wall_s'] * 1000:.1f} ms{goal}", file=sys.stderr)
+
+        model, records = replay(scenario, progress=progress)
+    except (ScenarioError, HierarchyError, CueError, UnknownPlaceError) as exc:
+        raise ExitError(str(exc)) from exc
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps({"scenario": str(args.scenario), "steps": records}, indent=1))
+    if args.plot:
+        from .drawing import save_picture
+
+        save_picture(model, args.plot, title=f"{args.scenario.name}: imagined map after {len(records) - 1} cues")
+    if args.save_model:
+        from .persistence import save
+
+        save(model, args.save_model)
+    if not args.quiet:
+        median = statistics.median(r["wall_s"] for r in records[1:]) if len(records) > 1 else records[0]["wall_s"]
+        print(f"wrote {args.out}; median settle {median * 1000:.1f} ms over {len(records) - 1} steps",
+              file=sys.stderr)
+    return 0

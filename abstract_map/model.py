@@ -1,0 +1,354 @@
+"""The abstract map: cues in, an imagined map of places out.
+
+State is plain data: the hierarchy, the clauses from every cue (kept per tag,
+so a tag seen again replaces rather than repeats its clauses), the fixed
+points (observed tags and the start), and each place's position and velocity.
+Springs, scale factors and natural lengths are derived from that state at
+every :meth:`AbstractMap.settle`. World frame, metres, radians.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .clauses import START_ANCHOR, Clause, Locational, Relational, is_anchor, tag_anchor
+from .dynamics import settle as run_dynamics
+from .grammar import Anchor, CueError, parse_cue
+from .hierarchy import Hierarchy
+from .params import STIFFNESS, AbstractMapParams
+from .placement import Resolved, place_new_masses
+from .prepositions import TABLE
+from .scales import ScaleKey, learn_scales, natural_length
+from .springs import Spring, springs_from_clauses
+
+
+class UnknownPlaceError(KeyError):
+    """A place that no cue or hierarchy mentions."""
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
+@dataclass
+class FixedPoint:
+    """A fixed mass: an observed tag (mean of its sightings) or the start pose."""
+
+    kind: str  # "label", "sign" or "start"
+    x: float  # m
+    y: float  # m
+    theta: float  # rad, facing direction (circular mean)
+    sightings: int = 1
+    text: str = ""
+
+    @property
+    def xy(self) -> np.ndarray:
+        return np.array([self.x, self.y])
+
+    def add_sighting(self, x: float, y: float, theta: float) -> None:
+        """Refine to the running mean of every sighting (circular mean for theta)."""
+        n = self.sightings
+        self.x += (x - self.x) / (n + 1)
+        self.y += (y - self.y) / (n + 1)
+        self.theta = math.atan2(n * math.sin(self.theta) + math.sin(theta),
+                                n * math.cos(self.theta) + math.cos(theta))
+        self.sightings = n + 1
+
+
+@dataclass(frozen=True)
+class SettleReport:
+    """What one settle did."""
+
+    settled: bool
+    iterations: int
+    wall_s: float
+    new_masses: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Observation:
+    """What observing a tag did to the model."""
+
+    tag_id: int
+    new: bool  # first sighting of this tag
+    clauses: tuple[Clause, ...]
+
+
+def _check_pose(pose: Iterable[float], what: str) -> tuple[float, float, float]:
+    values = tuple(float(v) for v in pose)
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise ValueError(f"{what}: expected a finite pose (x m, y m, theta rad), got {tuple(pose)!r}")
+    return values  # type: ignore[return-value]
+
+
+@dataclass
+class AbstractMap:
+    """A malleable imagined map of named places, anchored at the robot's start pose."""
+
+    hierarchy: Hierarchy
+    start: tuple[float, float, float]  # x m, y m, heading rad
+    params: AbstractMapParams = field(default_factory=AbstractMapParams)
+    goal: str | None = None
+    fixed: dict[str, FixedPoint] = field(default_factory=dict)
+    cue_clauses: dict[str, list[Clause]] = field(default_factory=dict)  # per anchor name
+    loose_clauses: list[Clause] = field(default_factory=list)  # clauses with no tag
+    positions: dict[str, np.ndarray] = field(default_factory=dict)
+    velocities: dict[str, np.ndarray] = field(default_factory=dict)
+    exploration_factor: float = 1.0
+    explored_centre: np.ndarray | None = None
+    start_roots: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.start = _check_pose(self.start, "start pose")
+        self.fixed.setdefault(START_ANCHOR, FixedPoint("start", *self.start, text="start"))
+        if not self.start_roots:
+            self.start_roots = self.hierarchy.roots() or [p for p in self.hierarchy.places
+                                                          if p not in self.hierarchy.parent]
+        if self.goal is not None:
+            self.set_goal(self.goal)
+
+    # -- building -----------------------------------------------------------------
+
+    @classmethod
+    def from_hierarchy(cls, hierarchy: Hierarchy, start: Iterable[float], *, goal: str | None = None,
+                       params: AbstractMapParams | None = None) -> AbstractMap:
+        """A model of the hierarchy alone, anchored at ``start`` = (x m, y m, heading rad)."""
+        return cls(hierarchy=hierarchy, start=tuple(start), params=params or AbstractMapParams(),  # type: ignore[arg-type]
+                   goal=goal)
+
+    def places(self) -> list[str]:
+        """Every place a cue or the hierarchy mentions, in first-mention order."""
+        names: dict[str, None] = dict.fromkeys(self.hierarchy.places)
+        for clause in self.clauses():
+            for name in _clause_names(clause):
+                if not is_anchor(name):
+                    names.setdefault(name, None)
+        return list(names)
+
+    def clauses(self) -> list[Clause]:
+        """All clauses: the hierarchy's, then each cue's, then loose ones."""
+        out: list[Clause] = list(self.hierarchy.clauses())
+        for clauses in self.cue_clauses.values():
+            out.extend(clauses)
+        out.extend(self.loose_clauses)
+        return out
+
+    def canonical(self, name: str) -> str:
+        """A known place's spelling for ``name`` (case-insensitive), else ``name`` itself."""
+        if name in self.positions or is_anchor(name):
+            return name
+        folded = name.casefold()
+        for known in self.places():
+            if known.casefold() == folded:
+                return known
+        return name
+
+    def _canonical_clause(self, clause: Clause) -> Clause:
+        if isinstance(clause, Relational):
+            context = clause.context and self.canonical(clause.context)
+            return Relational(clause.preposition, self.canonical(clause.figure),
+                              tuple(self.canonical(r) for r in clause.referents), context)
+        return Locational(clause.kind, self.canonical(clause.toponym), clause.anchor, clause.direction)
+
+    def _check_clause(self, clause: Clause) -> None:
+        if isinstance(clause, Relational) and clause.preposition not in TABLE:
+            raise CueError(f"clause {clause}: unknown preposition {clause.preposition!r}; known: {sorted(TABLE)}")
+        for name in _clause_names(clause):
+            if is_anchor(name) and name not in self.fixed:
+                raise CueError(f"clause {clause}: fixed point {name!r} has not been observed")
+
+    def add_clauses(self, clauses: Iterable[Clause]) -> list[Clause]:
+        """Add clauses with no tag of their own (e.g. spoken directions); returns the new ones.
+
+        "X is in Y" clauses also extend the hierarchy. A new clause resets exploration.
+        """
+        added = []
+        for clause in clauses:
+            clause = self._canonical_clause(clause)
+            self._check_clause(clause)
+            if clause in self.loose_clauses:
+                continue
+            self._extend_hierarchy(clause)
+            self.loose_clauses.append(clause)
+            added.append(clause)
+        if added:
+            self.exploration_factor = 1.0
+        return added
+
+    def _extend_hierarchy(self, clause: Clause) -> None:
+        if isinstance(clause, Relational) and TABLE[clause.preposition].hierarchy:
+            for parent in clause.referents:
+                if not is_anchor(parent) and not is_anchor(clause.figure):
+                    self.hierarchy.add(clause.figure, parent, where=f"clause {clause}")
+
+    def observe_tag(self, tag_id: int, text: str, pose: Iterable[float], *, kind: str | None = None) -> Observation:
+        """A tag read at world ``pose`` = (x m, y m, theta rad, the direction its face points).
+
+        The tag becomes a fixed mass; its text becomes clauses (``kind`` "label" or
+        "sign", inferred from the text when None). Seeing the tag again moves the fixed
+        mass to the mean of all sightings and re-derives its clauses, never adding
+        springs twice. A first sighting resets the exploration factor to 1.
+        """
+        x, y, theta = _check_pose(pose, f"tag {tag_id} pose")
+        name = tag_anchor(int(tag_id))
+        point = self.fixed.get(name)
+        new = point is None
+        if point is None:
+            clauses = parse_cue(text, Anchor(name, x, y, theta), kind=kind)
+            kind = "label" if all(isinstance(c, Locational) and c.kind == "label" for c in clauses) else "sign"
+            point = FixedPoint(kind, x, y, theta, text=text)
+            self.fixed[name] = point
+        else:
+            if text != point.text:
+                raise CueError(f"tag {tag_id}: text {text!r} differs from its earlier reading {point.text!r}")
+            point.add_sighting(x, y, theta)
+        try:
+            clauses = [self._canonical_clause(c) for c in
+                       parse_cue(point.text, Anchor(name, point.x, point.y, point.theta), kind=point.kind)]
+            for clause in clauses:
+                self._check_clause(clause)
+                self._extend_hierarchy(clause)
+        except Exception:
+            if new:
+                del self.fixed[name]
+            raise
+        if new:
+            self.exploration_factor = 1.0
+            for clause in clauses:  # reality overrides imagination: re-place newly observed places
+                if isinstance(clause, Locational) and clause.kind == "label" and not self.is_observed(clause.toponym):
+                    self.positions.pop(clause.toponym, None)
+                    self.velocities.pop(clause.toponym, None)
+        self.cue_clauses[name] = clauses
+        return Observation(int(tag_id), new, tuple(clauses))
+
+    # -- reading ------------------------------------------------------------------
+
+    def _anchor_kind(self, name: str) -> str:
+        return self.fixed[name].kind
+
+    def springs(self) -> list[Spring]:
+        """Every spring of the model (the start's pull on the roots included)."""
+        flags = {"between_angle": self.params.between_angle}
+        springs = springs_from_clauses(self.clauses(), self._anchor_kind, flags)
+        k = STIFFNESS[self.params.start_stiffness]
+        for root in self.start_roots:
+            springs.append(Spring("distance", (root, START_ANCHOR), 1.0, k, "start"))
+            springs.append(Spring("global_angle", (START_ANCHOR, root), self.start[2], k))
+        return springs
+
+    def levels(self) -> dict[str, int]:
+        """Hierarchy level of every place (places outside the hierarchy are leaves, 1)."""
+        levels = self.hierarchy.levels()
+        return {p: levels.get(p, 1) for p in self.places()}
+
+    def observed_position(self, name: str) -> np.ndarray | None:
+        """Where a place was observed (mean of its label tags), a fixed point's position, or None."""
+        if name in self.fixed:
+            return self.fixed[name].xy
+        labels = [self.fixed[c.anchor].xy for clauses in self.cue_clauses.values() for c in clauses
+                  if isinstance(c, Locational) and c.kind == "label" and c.toponym == name]
+        return np.mean(labels, axis=0) if labels else None
+
+    def is_observed(self, place: str) -> bool:
+        """True once a label of ``place`` has been read."""
+        return self.observed_position(self.canonical(place)) is not None
+
+    def scale_factors(self) -> dict[ScaleKey, float]:
+        """Learned scale factors (m per unit) by key; defaults are not listed."""
+        return learn_scales(self.springs(), self.levels(), self.observed_position)
+
+    def resolved_springs(self) -> list[Resolved]:
+        """Springs with natural lengths in metres and angles in radians."""
+        levels = self.levels()
+        springs = self.springs()
+        learned = learn_scales(springs, levels, self.observed_position)
+        out = []
+        for s in springs:
+            value = (natural_length(s, levels, learned, self.params.scales, self.exploration_factor)
+                     if s.kind == "distance" else s.value)
+            out.append(Resolved(s.kind, s.ends, value, s.stiffness))
+        return out
+
+    def position(self, place: str) -> np.ndarray:
+        """Imagined position (m, world) of a place."""
+        name = self.canonical(place)
+        if name not in self.positions:
+            known = self.places()
+            if name in known:
+                raise UnknownPlaceError(f"place {place!r} has no position yet: call settle() first")
+            raise UnknownPlaceError(f"place {place!r} is not mentioned by any cue or the hierarchy")
+        return self.positions[name].copy()
+
+    def set_goal(self, place: str) -> None:
+        name = self.canonical(place)
+        if name not in self.places():
+            raise UnknownPlaceError(f"goal {place!r} is not mentioned by any cue or the hierarchy; "
+                                    f"known places: {sorted(self.places())}")
+        self.goal = name
+
+    def goal_estimate(self) -> np.ndarray:
+        """Imagined position (m, world) of the goal."""
+        if self.goal is None:
+            raise UnknownPlaceError("no goal set")
+        return self.position(self.goal)
+
+    # -- changing -----------------------------------------------------------------
+
+    def bump_exploration(self) -> float:
+        """The goal was not where imagined: grow imagined distances by the exploration step."""
+        step, law = self.params.exploration.step, self.params.exploration.law
+        self.exploration_factor = EXPLORATION_LAWS[law](self.exploration_factor, step)
+        return self.exploration_factor
+
+    def set_explored_centre(self, xy: Iterable[float] | None) -> None:
+        """Centre (m, world) of explored free space; the expansion force pushes away from it."""
+        if xy is None:
+            self.explored_centre = None
+            return
+        centre = np.array([float(v) for v in xy])
+        if centre.shape != (2,) or not np.all(np.isfinite(centre)):
+            raise ValueError(f"explored centre: expected finite (x, y) in metres, got {xy!r}")
+        self.explored_centre = centre
+
+    def settle(self) -> SettleReport:
+        """Place new masses (Algorithm 2), then integrate until settled (Algorithm 1)."""
+        began = time.perf_counter()
+        springs = self.resolved_springs()
+        places = self.places()
+        new = [p for p in places if p not in self.positions]
+        known = {**{n: f.xy for n, f in self.fixed.items()}, **self.positions}
+        origin = np.array(self.start[:2])
+        placed = place_new_masses(new, known, springs, origin=origin, heading=self.start[2],
+                                  min_separation=self.params.dynamics.min_separation)
+        for name, xy in placed.items():
+            self.positions[name] = xy
+            self.velocities[name] = np.zeros(2)
+        leaves = [p for p in places if self.hierarchy.is_leaf(p)]
+        expand = leaves if self.params.dynamics.expansion_on == "leaves" else places
+        result = run_dynamics({p: self.positions[p] for p in places}, self.velocities,
+                              {n: f.xy for n, f in self.fixed.items()}, springs,
+                              expand=expand, centre=self.explored_centre, params=self.params.dynamics)
+        self.positions.update(result.positions)
+        self.velocities.update(result.velocities)
+        return SettleReport(result.settled, result.iterations, time.perf_counter() - began, tuple(new))
+
+
+EXPLORATION_LAWS = {
+    "multiplicative": lambda factor, step: factor * (1.0 + step),
+    "additive": lambda factor, step: factor + step,
+}
+
+
+def _clause_names(clause: Clause) -> list[str]:
+    if isinstance(clause, Relational):
+        return [clause.figure, *clause.referents, *([clause.context] if clause.context else [])]
+    return [clause.toponym, clause.anchor]
+
+
+def imagined_positions(model: AbstractMap) -> Mapping[str, tuple[float, float]]:
+    """Positions of every place as plain floats, for JSON."""
+    return {name: (float(xy[0]), float(xy[1])) for name, xy in model.positions.items()}

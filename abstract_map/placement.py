@@ -1,0 +1,142 @@
+"""Algorithm 2: give new point masses a starting position.
+
+New masses are placed one at a time, the most constrained first (descending
+total stiffness of attached springs), each where its springs to masses already
+placed are best satisfied, with zero velocity. A mass held only by distance
+springs to a single placed neighbour is fanned out ahead of that neighbour
+(away from the start), so that siblings do not start on top of each other.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
+
+
+@dataclass(frozen=True)
+class Resolved:
+    """A spring with its natural value in SI units: metres (distance) or radians (angles)."""
+
+    kind: str
+    ends: tuple[str, ...]
+    value: float
+    stiffness: float
+
+
+def _fan_angle(k: int) -> float:
+    """The k-th fan offset (rad) in [-pi/2, pi/2), starting straight ahead."""
+    return math.pi * (((k * GOLDEN) + 0.5) % 1.0 - 0.5)
+
+
+def _unit(angle: float) -> np.ndarray:
+    return np.array([math.cos(angle), math.sin(angle)])
+
+
+def _fit_distances(x0: np.ndarray, points: np.ndarray, lengths: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """Least-squares point at the given distances from ``points`` (gradient descent from ``x0``)."""
+    x = x0.astype(float).copy()
+    step = 0.5 / max(float(weights.sum()), 1e-9)
+    for _ in range(200):
+        d = x - points
+        r = np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-9)
+        grad = ((weights * (r - lengths) / r)[:, None] * d).sum(axis=0)
+        x -= step * grad
+        if float(np.hypot(*grad)) < 1e-6:
+            break
+    return x
+
+
+def place_new_masses(new: Sequence[str], known: Mapping[str, np.ndarray], springs: Sequence[Resolved], *,
+                     origin: np.ndarray, heading: float, min_separation: float) -> dict[str, np.ndarray]:
+    """Starting positions (m, world) for the masses ``new`` given the ``known`` ones."""
+    placed = {name: np.asarray(p, dtype=float) for name, p in known.items()}
+    total = {name: 0.0 for name in new}
+    for spring in springs:
+        for end in spring.ends:
+            if end in total:
+                total[end] += spring.stiffness
+    order = sorted(new, key=lambda n: -total[n])  # stable: ties keep first-seen order
+    fan_count: dict[str, int] = {}
+    result: dict[str, np.ndarray] = {}
+    while order:
+        name = next((n for n in order if _neighbours(n, springs, placed)), order[0])
+        order.remove(name)
+        position = _best_position(name, springs, placed, fan_count, origin=origin, heading=heading)
+        position = _separate(position, placed, min_separation)
+        placed[name] = result[name] = position
+    return result
+
+
+def _neighbours(name: str, springs: Sequence[Resolved], placed: Mapping[str, np.ndarray]) -> bool:
+    return any(name in s.ends and all(e in placed for e in s.ends if e != name) for s in springs)
+
+
+def _length_between(name: str, other: str, springs: Sequence[Resolved], fallback: float) -> float:
+    lengths = [s.value for s in springs if s.kind == "distance" and set(s.ends) == {name, other}]
+    return lengths[0] if lengths else fallback
+
+
+def _best_position(name: str, springs: Sequence[Resolved], placed: Mapping[str, np.ndarray],
+                   fan_count: dict[str, int], *, origin: np.ndarray, heading: float) -> np.ndarray:
+    distance = [s for s in springs if s.kind == "distance" and name in s.ends
+                and all(e in placed for e in s.ends if e != name)]
+    typical = float(np.mean([s.value for s in distance])) if distance else 1.0
+    candidates: list[tuple[np.ndarray, float]] = []
+    for s in springs:
+        if name not in s.ends or not all(e in placed for e in s.ends if e != name):
+            continue
+        if s.kind == "global_angle" and s.ends[1] == name:
+            ref = placed[s.ends[0]]
+            candidates.append((ref + _length_between(name, s.ends[0], springs, typical) * _unit(s.value),
+                               s.stiffness))
+        elif s.kind == "relative_angle" and s.ends[2] == name:
+            a, vertex = placed[s.ends[0]], placed[s.ends[1]]
+            base = math.atan2(*(a - vertex)[::-1])
+            length = _length_between(name, s.ends[1], springs, typical)
+            candidates.append((vertex + length * _unit(base + s.value), s.stiffness))
+        elif s.kind == "relative_angle" and s.ends[1] == name and abs(abs(s.value) - math.pi) < 1e-9:
+            a, b = placed[s.ends[0]], placed[s.ends[2]]
+            ab = a - b
+            norm = float(np.hypot(*ab))
+            if norm > 1e-9:
+                length = min(_length_between(name, s.ends[2], springs, typical), norm)
+                candidates.append((b + length * ab / norm, s.stiffness))
+    if candidates:
+        weights = np.array([w for _, w in candidates])
+        return (np.array([c for c, _ in candidates]) * weights[:, None]).sum(axis=0) / weights.sum()
+    if not distance:
+        k = fan_count.get("", 0)
+        fan_count[""] = k + 1
+        return origin + (1.0 + k) * _unit(heading + _fan_angle(k))
+    others = [s.ends[0] if s.ends[1] == name else s.ends[1] for s in distance]
+    points = np.array([placed[o] for o in others])
+    lengths = np.array([s.value for s in distance])
+    weights = np.array([s.stiffness for s in distance])
+    if len(set(others)) == 1:
+        anchor = others[0]
+        away = points[0] - origin
+        outward = math.atan2(away[1], away[0]) if float(np.hypot(*away)) > 1e-6 else heading
+        k = fan_count.get(anchor, 0)
+        fan_count[anchor] = k + 1
+        return points[0] + float(lengths.mean()) * _unit(outward + _fan_angle(k))
+    centroid = (points * weights[:, None]).sum(axis=0) / weights.sum()
+    k = fan_count.get("*", 0)
+    fan_count["*"] = k + 1
+    start = centroid + float(lengths.mean()) * 0.5 * _unit(heading + _fan_angle(k))
+    return _fit_distances(start, points, lengths, weights)
+
+
+def _separate(position: np.ndarray, placed: Mapping[str, np.ndarray], min_separation: float) -> np.ndarray:
+    """Nudge a position so that it keeps ``min_separation`` from every placed mass."""
+    position = position.copy()
+    for k in range(16):
+        clash = [p for p in placed.values() if float(np.hypot(*(position - p))) < min_separation]
+        if not clash:
+            break
+        position = position + min_separation * _unit(_fan_angle(k + 1) * 2.0)
+    return position

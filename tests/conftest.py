@@ -1,0 +1,5 @@
+"""Shared test set-up: matplotlib draws off-screen."""
+
+import matplotlib
+
+matplotlib.use("Agg")

@@ -1,0 +1,165 @@
+"""Observations, scale learning, exploration, goals, persistence and determinism."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from abstract_map import persistence
+from abstract_map.grammar import CueError
+from abstract_map.model import UnknownPlaceError
+from abstract_map.scenario import load_scenario, replay
+
+from .helpers import make_map, settle
+
+NORTH, SOUTH = math.pi / 2, -math.pi / 2
+LION = Path(__file__).resolve().parents[2] / "worlds" / "zoo" / "lion_replay.json"
+
+
+def test_seeing_a_tag_again_refines_its_pose_without_new_springs():
+    model = make_map()
+    model.observe_tag(1, "$LEFT$ A\nB is past A", (0.0, 0.0, NORTH))
+    springs = model.springs()
+    again = model.observe_tag(1, "$LEFT$ A\nB is past A", (0.2, 0.0, NORTH + 0.1))
+    assert not again.new
+    assert len(model.springs()) == len(springs)
+    point = model.fixed["#1"]
+    assert (point.x, point.y, point.sightings) == (pytest.approx(0.1), pytest.approx(0.0), 2)
+    assert point.theta == pytest.approx(NORTH + 0.05)
+
+
+def test_a_tag_cannot_change_its_text():
+    model = make_map()
+    model.observe_tag(1, "A", (0.0, 0.0, NORTH))
+    with pytest.raises(CueError, match="differs"):
+        model.observe_tag(1, "B", (0.0, 0.0, NORTH))
+
+
+def test_nan_pose_is_an_error():
+    model = make_map()
+    with pytest.raises(ValueError, match="tag 4 pose"):
+        model.observe_tag(4, "A", (float("nan"), 0.0, 0.0))
+    with pytest.raises(ValueError, match="start pose"):
+        make_map(start=(0.0, float("inf"), 0.0))
+    assert "#4" not in model.fixed
+
+
+def test_unknown_goal_is_an_error():
+    with pytest.raises(UnknownPlaceError, match="Narnia"):
+        make_map(goal="Narnia")
+    model = make_map(goal="a")  # case-insensitive match to a known place
+    assert model.goal == "A"
+
+
+def test_unknown_place_position_is_an_error():
+    model = make_map()
+    settle(model)
+    with pytest.raises(UnknownPlaceError, match="Narnia"):
+        model.position("Narnia")
+
+
+def test_scale_learning_uses_observed_distances():
+    model = make_map()
+    model.observe_tag(1, "A is near B", (0.0, 0.0, NORTH))
+    assert ("place", 1, 1) not in model.scale_factors()
+    model.observe_tag(2, "A", (0.0, 3.0, SOUTH))
+    model.observe_tag(3, "B", (6.0, 3.0, SOUTH))
+    scales = model.scale_factors()
+    # "near" is half a unit: 6 m observed between the labels -> 12 m per unit (equation 7)
+    assert scales[("place", 1, 1)] == pytest.approx(12.0)
+    # and the near spring's natural length follows it
+    lengths = [s.value for s in model.resolved_springs() if s.kind == "distance" and set(s.ends) == {"A", "B"}]
+    assert lengths == [pytest.approx(6.0)]
+
+
+def test_scale_is_the_stiffness_weighted_mean():
+    model = make_map()
+    model.observe_tag(1, "A is near B\nC is past B", (0.0, -5.0, NORTH))
+    for tag, name, x in [(2, "A", 0.0), (3, "B", 4.0), (4, "C", 14.0)]:
+        model.observe_tag(tag, name, (x, 3.0, SOUTH))
+    # near: K 1, 4 m / 0.5 = 8; past: K 0.1, 10 m / 1 = 10 -> (1*8 + 0.1*10) / 1.1
+    assert model.scale_factors()[("place", 1, 1)] == pytest.approx((8.0 + 1.0) / 1.1)
+
+
+def test_exploration_bump_grows_distances_and_a_new_cue_resets_it():
+    model = make_map(tree={"Campus": {"A": {}}})
+    model.observe_tag(1, "$UP$ A", (0.0, 0.0, SOUTH))
+    settle(model)
+    before = np.hypot(*model.position("A"))
+    assert model.bump_exploration() == pytest.approx(1.25)
+    assert model.bump_exploration() == pytest.approx(1.5625)
+    settle(model)
+    assert np.hypot(*model.position("A")) > before * 1.3
+    model.observe_tag(1, "$UP$ A", (0.0, 0.0, SOUTH))  # the same cue again: no reset
+    assert model.exploration_factor == pytest.approx(1.5625)
+    model.observe_tag(2, "B is near A", (0.0, 0.0, NORTH))
+    assert model.exploration_factor == 1.0
+
+
+def test_label_springs_are_not_explored():
+    model = make_map()
+    model.observe_tag(2, "A", (0.0, 0.0, NORTH))
+    model.bump_exploration()
+    (length,) = [s.value for s in model.resolved_springs() if s.kind == "distance" and "#2" in s.ends]
+    assert length == pytest.approx(2.0)
+
+
+def test_save_load_round_trip_is_exact(tmp_path):
+    scenario = load_scenario(LION)
+    model, _ = replay(scenario)
+    path = tmp_path / "model.json"
+    persistence.save(model, path)
+    loaded = persistence.load(path)
+    assert loaded.positions.keys() == model.positions.keys()
+    for name in model.positions:
+        assert np.array_equal(loaded.positions[name], model.positions[name])
+    model.observe_tag(17, "Lion", (-21.7, 17.7, SOUTH))
+    loaded.observe_tag(17, "Lion", (-21.7, 17.7, SOUTH))
+    model.settle(), loaded.settle()
+    for name in model.positions:
+        assert np.array_equal(loaded.positions[name], model.positions[name])
+
+
+def test_loading_a_bad_file_names_it(tmp_path):
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"format": "abstract-map/0"}')
+    with pytest.raises(persistence.ModelFileError, match="bad.json"):
+        persistence.load(bad)
+
+
+def test_replay_is_deterministic():
+    first = replay(load_scenario(LION))[1]
+    second = replay(load_scenario(LION))[1]
+    strip = lambda records: [{k: v for k, v in r.items() if k != "wall_s"} for r in records]  # noqa: E731
+    assert strip(first) == strip(second)
+
+
+def test_lion_replay_ends_near_the_lion():
+    records = replay(load_scenario(LION))[1]
+    assert len(records) == 15 and all(r["settled"] for r in records)
+    lion = np.array([-21.70, 17.70])  # the Lion's label tag 17
+    first, last = np.array(records[0]["goal"]), np.array(records[-1]["goal"])
+    assert np.hypot(*(last - lion)) < 10.0 < np.hypot(*(first - lion))
+
+
+def test_core_never_imports_the_simulator():
+    code = ("import sys, abstract_map.model, abstract_map.scenario, abstract_map.persistence, abstract_map.drawing;"
+            "bad = [m for m in sys.modules if m.split('.')[0] in ('sim', 'pybullet', 'cv2', 'matplotlib')];"
+            "print(bad); sys.exit(1 if bad else 0)")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_picture_is_written(tmp_path):
+    from abstract_map.drawing import save_picture
+
+    model = make_map(goal="A")
+    model.observe_tag(1, "$LEFT$ A", (0.0, 0.0, NORTH))
+    settle(model)
+    save_picture(model, tmp_path / "map.png")
+    assert (tmp_path / "map.png").stat().st_size > 10_000
