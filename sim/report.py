@@ -120,7 +120,7 @@ def comparison_plot(rows: list[GoalRow], path: str | os.PathLike[str]) -> None:
         for j, (name, values) in enumerate(series.items()):
             if not values:
                 continue
-            box = ax.boxplot([values], positions=[base + 1 - j], vert=False, widths=0.7, patch_artist=True,
+            box = ax.boxplot([values], positions=[base + 1 - j], orientation="horizontal", widths=0.7, patch_artist=True,
                              whis=(0, 100))
             box["boxes"][0].set(facecolor=colours[name], alpha=0.35, edgecolor=colours[name])
         if row.oracle_m is not None:

@@ -219,6 +219,9 @@ def _loop(world: World, goal: str, scene: Any, start: tuple[float, float, float]
             frames.append(Frame(t, now, grid.to_image(), _places(nav), tuple(target),
                                 None if replanner.plan is None else replanner.plan.waypoints))
     trajectory.append((t, *robot.true_pose()))
+    if record:
+        frames.append(Frame(t, robot.true_pose(), grid.to_image(), _places(nav), tuple(nav.target()),
+                            None if replanner.plan is None else replanner.plan.waypoints))
     if progress:
         progress(t, distance, len(nav.cues))
     settle_ms = [s.wall_s * 1000 for s in nav.settles[1:]] or [nav.settles[0].wall_s * 1000]

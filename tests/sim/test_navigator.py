@@ -1,0 +1,62 @@
+"""The navigator's decisions, without a simulator."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sim.navigator import Navigator
+from sim.perception.sighting import Sighting
+
+
+def sighting(world, tag_id: int) -> Sighting:
+    tag = world.tags[tag_id]
+    return Sighting(tag_id, tag.x, tag.y, tag.theta, 2.0)
+
+
+def test_starts_with_the_goal_imagined_ahead(tiny_world):
+    nav = Navigator.start(tiny_world, "A", tiny_world.start)
+    target = nav.target()
+    assert target[0] > tiny_world.start[0]  # the start faces +x
+    x0, x1, y0, y1 = tiny_world.floorplan.extent
+    assert x0 < target[0] < x1 and y0 < target[1] < y1  # clamped into the map
+
+
+def test_a_sign_moves_the_goal_and_its_label_ends_the_trial(tiny_world):
+    nav = Navigator.start(tiny_world, "A", tiny_world.start)
+    before = nav.target()
+    assert nav.observe([sighting(tiny_world, 2)], t_s=1.0, distance_m=0.5, explored_centre=(2.0, 2.0))
+    assert [c.tag_id for c in nav.cues] == [2] and not nav.succeeded
+    assert not np.allclose(before, nav.target())
+    # the same sign again changes nothing worth a settle
+    assert not nav.observe([sighting(tiny_world, 2)], t_s=2.0, distance_m=0.6, explored_centre=None)
+    nav.observe([sighting(tiny_world, 0)], t_s=3.0, distance_m=1.0, explored_centre=None)
+    assert nav.succeeded and nav.model.is_observed("A")
+
+
+def test_empty_and_unknown_tags_are_ignored(tiny_world):
+    nav = Navigator.start(tiny_world, "A", tiny_world.start)
+    assert not nav.observe([sighting(tiny_world, 3), Sighting(99, 0.0, 0.0, 0.0, 1.0)], t_s=0.0,
+                           distance_m=0.0, explored_centre=None)
+    assert nav.cues == []
+
+
+def test_arriving_without_the_goal_bumps_until_exhausted(tiny_world):
+    from sim.navigator import NavigatorParams
+
+    nav = Navigator.start(tiny_world, "A", tiny_world.start, params=NavigatorParams(max_bumps=2))
+    assert nav.arrived_without_goal((2.0, 2.0))
+    assert nav.model.exploration_factor == pytest.approx(1.25)
+    assert nav.arrived_without_goal((2.0, 2.0))
+    assert not nav.arrived_without_goal((2.0, 2.0))
+    nav.observe([sighting(tiny_world, 2)], t_s=1.0, distance_m=0.5, explored_centre=None)
+    assert nav.model.exploration_factor == 1.0 and nav.bumps_in_a_row == 0
+
+
+def test_unknown_goal_is_an_error(tiny_world):
+    from abstract_map.model import UnknownPlaceError
+
+    with pytest.raises(UnknownPlaceError, match="Narnia"):
+        Navigator.start(tiny_world, "Narnia", tiny_world.start)
