@@ -1,6 +1,7 @@
 """Force laws for the angle springs and the expansion force, as one precomputed field.
 
-Positions are an array ``(n, 2)`` in metres, world frame; forces are newtons.
+Positions are complex numbers ``x + iy`` in metres, world frame; forces are
+newtons, complex likewise.
 Angle springs push tangentially with magnitude ``K * error`` (N, with the
 error in radians), faded linearly to zero within ``core`` metres of their pivot
 where the angle is ill-defined; the reaction on the reference or vertex keeps
@@ -33,9 +34,13 @@ class ForceField:
     Global angle springs hold the direction of ``g_fig`` seen from ``g_ref`` at
     ``g_angle``; relative angle springs hold the angle at ``r_vertex`` from ``r_a``
     to ``r_b`` (counter-clockwise) at ``r_angle``; ``expand`` masses are pushed
-    away from ``centre``. Every angle spring acts along vectors ("pairs") from a
-    tail to a head mass: the head is pushed along the pair's tangent and the tail
-    takes the reaction, so one gather and one incidence product give every force.
+    away from ``centre``. Positions and forces are complex numbers ``x + iy``.
+
+    Every angle spring acts along vectors ("pairs") from a tail to a head mass;
+    a spring's error is the angle of its second pair minus that of its first
+    (a global spring's first pair is the x axis). Each head is pushed along its
+    pair's tangent and the tail takes the reaction, so one gather and one
+    incidence product give every force.
     """
 
     n: int
@@ -49,48 +54,51 @@ class ForceField:
     r_angle: np.ndarray
     r_k: np.ndarray
     expand: np.ndarray
-    centre: np.ndarray | None = None
+    centre: complex | None = None
     expansion: float = 0.0  # N or N/m, by law
     law: str = "constant"
     core: float = 0.5  # m
 
     def __post_init__(self) -> None:
         n_g, n_r = len(self.g_ref), len(self.r_a)
-        heads = np.concatenate([self.g_fig, np.ravel(np.column_stack([self.r_a, self.r_b]))]).astype(int)
-        tails = np.concatenate([self.g_ref, np.repeat(self.r_vertex, 2)]).astype(int)
-        incidence = np.zeros((self.n, len(heads)))
-        np.add.at(incidence, (heads, np.arange(len(heads))), 1.0)
-        np.add.at(incidence, (tails, np.arange(len(heads))), -1.0)
-        object.__setattr__(self, "_heads", heads)
-        object.__setattr__(self, "_tails", tails)
-        object.__setattr__(self, "_incidence", incidence)
-        object.__setattr__(self, "_n_g", n_g)
-        object.__setattr__(self, "_n_r", n_r)
+        heads = np.concatenate([self.g_fig, self.r_a, self.r_b]).astype(int)
+        tails = np.concatenate([self.g_ref, self.r_vertex, self.r_vertex]).astype(int)
+        n_pairs = len(heads)
+        incidence = np.zeros((self.n, n_pairs))
+        np.add.at(incidence, (heads, np.arange(n_pairs)), 1.0)
+        np.add.at(incidence, (tails, np.arange(n_pairs)), -1.0)
+        # Spring s measures angle(pair second[s]) - angle(pair first[s]); index n_pairs is the x axis.
+        first = np.concatenate([np.full(n_g, n_pairs), n_g + np.arange(n_r)]).astype(int)
+        second = np.concatenate([np.arange(n_g), n_g + n_r + np.arange(n_r)]).astype(int)
+        # Pair force = sign x spring torque-force: the second pair is pushed back (-), the first forward (+).
+        sign = np.zeros((n_pairs + 1, n_g + n_r))
+        sign[second, np.arange(n_g + n_r)] = -1.0
+        sign[first, np.arange(n_g + n_r)] += 1.0
+        fields = {"_heads": heads, "_tails": tails, "_incidence": incidence, "_first": first, "_second": second,
+                  "_sign": sign[:n_pairs], "_target": np.concatenate([self.g_angle, self.r_angle]),
+                  "_k": np.concatenate([self.g_k, self.r_k])}
+        for name, value in fields.items():
+            object.__setattr__(self, name, value)
 
-    def __call__(self, pos: np.ndarray) -> np.ndarray:
-        """Total force (N) on each of the ``n`` masses at positions ``pos`` (m)."""
-        n_g = self._n_g  # type: ignore[attr-defined]
-        if len(self._heads):  # type: ignore[attr-defined]
-            d = pos[self._heads] - pos[self._tails]  # type: ignore[attr-defined]
-            length = np.hypot(d[:, 0], d[:, 1])
-            angle = np.arctan2(d[:, 1], d[:, 0])
-            gain = np.minimum(1.0, length / self.core) if self.core > 0 else (length > 1e-9) * 1.0
-            scale = np.empty_like(length)
-            scale[:n_g] = -self.g_k * wrap(angle[:n_g] - self.g_angle) * gain[:n_g]
-            ang_a, ang_b = angle[n_g::2], angle[n_g + 1::2]
-            w = self.r_k * wrap(ang_b - ang_a - self.r_angle) * gain[n_g::2] * gain[n_g + 1::2]
-            scale[n_g::2] = w
-            scale[n_g + 1::2] = -w
-            scale /= np.maximum(length, 1e-9)  # tangent of d is (-dy, dx) / |d|
-            push = d[:, ::-1] * scale[:, None]
-            push[:, 0] *= -1.0
+    def __call__(self, z: np.ndarray) -> np.ndarray:
+        """Total force (N, complex) on each of the ``n`` masses at complex positions ``z`` (m)."""
+        heads = self._heads  # type: ignore[attr-defined]
+        if len(heads):
+            d = z[heads] - z[self._tails]  # type: ignore[attr-defined]
+            length = np.abs(d)
+            angle = np.append(np.angle(d), 0.0)
+            gain = np.append(np.minimum(1.0, length / self.core) if self.core > 0 else 1.0 * (length > 0), 1.0)
+            first, second = self._first, self._second  # type: ignore[attr-defined]
+            error = wrap(angle[second] - angle[first] - self._target)  # type: ignore[attr-defined]
+            spring = self._k * error * gain[first] * gain[second]  # type: ignore[attr-defined]
+            push = (self._sign @ spring) / np.maximum(length, 1e-9) * 1j * d  # type: ignore[attr-defined]
             forces = self._incidence @ push  # type: ignore[attr-defined]
         else:
-            forces = np.zeros((self.n, 2))
+            forces = np.zeros(self.n, dtype=complex)
         if self.centre is not None and len(self.expand) and self.expansion != 0.0:
-            d = pos[self.expand] - self.centre
-            length = np.hypot(d[:, 0], d[:, 1])
+            d = z[self.expand] - self.centre
+            length = np.abs(d)
             ok = length > 1e-9
             magnitude = EXPANSION_LAWS[self.law](self.expansion, length) * ok
-            forces[self.expand] += (magnitude / np.where(ok, length, 1.0))[:, None] * d
+            forces[self.expand] += magnitude / np.where(ok, length, 1.0) * d
         return forces
