@@ -41,7 +41,8 @@ class Locational:
     """``loc(toponym, W, x, y, r, theta)``: a place located from a fixed point in the world.
 
     ``kind`` is "label" (the place lies behind the tag: ``direction`` is the tag's
-    normal plus pi) or "arrow" (the place lies in ``direction`` from the sign).
+    normal plus pi), "arrow" (the place lies in ``direction`` from the sign) or
+    "here" (a place a sign calls "here" lies behind it, distance unsaid).
     """
 
     kind: str

@@ -7,7 +7,8 @@ characters backslash-n (as in the QUT cue mapping). A sign line is one of:
 - an arrow: ``$LEFT$ A, B and C`` (with or without a space after the arrow);
 - a phrase: ``[from CONTEXT,] FIGURES is|are PREPOSITION REFERENTS[, from CONTEXT]``,
   where FIGURES and REFERENTS are lists joined by commas and "and", and the
-  referent "here" means the sign itself.
+  referent "here" means the sign itself; a place "near here" also gets a
+  "here" clause: like a label's place, it lies behind the sign's face.
 
 Leading articles ("the", and a lower-case "a"/"an") are not part of a name.
 Anything that cannot be parsed raises :class:`CueError` naming the line.
@@ -122,7 +123,11 @@ def parse_phrase(line: str, anchor: Anchor | None, *, where: str) -> list[Clause
         raise CueError(f"{where}: {preposition!r} takes {low} to {high} referents, got {len(referents)}")
     if context is None and anchor is not None:
         context = anchor.name
-    return [Relational(preposition, figure, referents, context) for figure in figures]
+    clauses: list[Clause] = [Relational(preposition, figure, referents, context) for figure in figures]
+    if anchor is not None and anchor.name in referents and not row.hierarchy:
+        behind = math.remainder(anchor.theta + math.pi, math.tau)
+        clauses += [Locational("here", figure, anchor.name, behind) for figure in figures]
+    return clauses
 
 
 def parse_line(line: str, anchor: Anchor | None, *, where: str = "cue") -> list[Clause]:

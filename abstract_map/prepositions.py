@@ -69,6 +69,9 @@ LOCATIONAL: dict[str, tuple[Rule, ...]] = {
     # An arrow on a sign: the place lies that way, at the sign scale.
     "arrow": (Rule("distance", ("toponym", "anchor"), 1.0, "S"),
               Rule("global_angle", ("anchor", "toponym"), 0.0, "M")),
+    # "X is near here": like a label, the sign marks a place behind its face; the distance comes
+    # from the phrase's own preposition (our addition: the paper gives "here" no direction).
+    "here": (Rule("global_angle", ("anchor", "toponym"), 0.0, "M"),),
 }
 
 ARROWS: dict[str, float] = {

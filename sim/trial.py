@@ -24,6 +24,7 @@ from .perception import GeometricParams, make_perception
 from .planner import PlannerParams, ReplanParams, Replanner
 from .robot import Robot, RobotParams
 from .scene import build_scene
+from .targeting import Target, TargetParams, choose_target
 from .world_data import World, load_world
 
 
@@ -44,9 +45,12 @@ class TrialParams:
     trajectory_hz: float = 2.0  # Hz of the recorded trajectory
     record_every_s: float = 2.0  # s of simulated time between animation frames (with record=True)
     navigator: NavigatorParams = field(default_factory=NavigatorParams)
-    planner: PlannerParams = field(default_factory=PlannerParams)
+    # An imagined goal beyond a wall leads to the nearest reachable cell within 10 m of it.
+    planner: PlannerParams = field(default_factory=lambda: PlannerParams(goal_snap_radius_m=10.0))
     replan: ReplanParams = field(default_factory=ReplanParams)
     follower: FollowerParams = field(default_factory=FollowerParams)
+    targeting: TargetParams = field(default_factory=TargetParams)
+    target_recheck_s: float = 5.0  # s between re-choosing the target when the model has not changed
     laser: LaserParams = field(default_factory=LaserParams)
     occupancy_resolution_m: float = 0.1  # m, grid cell
 
@@ -166,13 +170,16 @@ def _loop(world: World, goal: str, scene: Any, start: tuple[float, float, float]
     trajectory = [(0.0, *last)]
     frames: list[Frame] = []
     reason = ""
+    target: Target | None = None
+    target_at = -math.inf
     while True:
         pose = robot.pose()
         centre = grid.explored_centre()
         if n % every["map"] == 0:
             grid.integrate(pose, angles, scan(pose, cast, params.laser, rng), params.laser.max_range_m)
         if n % every["see"] == 0:
-            nav.observe(sensor.observe(robot), t_s=t, distance_m=distance, explored_centre=centre)
+            if nav.observe(sensor.observe(robot), t_s=t, distance_m=distance, explored_centre=centre):
+                target = None
             if nav.succeeded:
                 reason = "goal label read"
                 break
@@ -182,7 +189,12 @@ def _loop(world: World, goal: str, scene: Any, start: tuple[float, float, float]
         if distance >= params.max_distance_m:
             reason = f"distance cap of {params.max_distance_m:.0f} m reached"
             break
-        target = nav.target()
+        # A stand-in target is kept until the model changes; the imagined goal is re-checked as the map grows.
+        if target is None or (not target.local and t - target_at >= params.target_recheck_s):
+            detours = nav.bumps_in_a_row >= params.targeting.local_bumps
+            target = choose_target(grid, np.array(pose[:2]), nav.target(), params.planner, params.targeting,
+                                   allow_detours=detours)
+            target_at = t
         v = w = 0.0
         if recovery.active:
             step = recovery.step(t)
@@ -191,7 +203,7 @@ def _loop(world: World, goal: str, scene: Any, start: tuple[float, float, float]
                 replanner.request()
                 stuck.reset()
         else:
-            plan = replanner.update(t, grid, pose[:2], target)
+            plan = replanner.update(t, grid, pose[:2], target.xy)
             arrived = plan is None
             if plan is not None:
                 v, w, done = follower.command(pose, plan.waypoints, tick)
@@ -203,6 +215,7 @@ def _loop(world: World, goal: str, scene: Any, start: tuple[float, float, float]
                     reason = "exploration exhausted: the goal was not found where imagined"
                     break
                 bumps += 1
+                target = None
                 replanner.request()
         robot.command(v, w)
         scene.step(steps_per_tick)
@@ -216,7 +229,8 @@ def _loop(world: World, goal: str, scene: Any, start: tuple[float, float, float]
         if progress and n % round(1.0 / tick) == 0:
             progress(t, distance, len(nav.cues))
         if record and n % frame_every == 0:
-            frames.append(Frame(t, now, grid.to_image(), _places(nav), tuple(target),
+            shown = nav.target() if target is None else target.xy
+            frames.append(Frame(t, now, grid.to_image(), _places(nav), tuple(shown),
                                 None if replanner.plan is None else replanner.plan.waypoints))
     trajectory.append((t, *robot.true_pose()))
     if record:

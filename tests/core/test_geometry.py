@@ -71,12 +71,14 @@ def test_between_puts_figure_between_referents():
     assert b[0] < a[0] < c[0]
 
 
-def test_near_here_means_the_sign():
+def test_near_here_means_the_sign_and_behind_it():
     model = make_map()
     model.observe_tag(1, "The A is near here", (3.0, 4.0, NORTH))
     settle(model)
-    # half a unit at the sign scale of 8 m
-    assert np.hypot(*(model.position("A") - np.array([3.0, 4.0]))) == pytest.approx(4.0, abs=1.0)
+    a = model.position("A")
+    # half a unit at the sign scale of 8 m, behind the sign's face (it faces +y)
+    assert np.hypot(*(a - np.array([3.0, 4.0]))) == pytest.approx(4.0, abs=1.0)
+    assert a[1] < 4.0 - 2.0
 
 
 @pytest.mark.parametrize("arrow, direction", [("LEFT", (1, 0)), ("RIGHT", (-1, 0)), ("UP", (0, -1)),

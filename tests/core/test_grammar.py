@@ -36,7 +36,7 @@ ZOO_SIGNS = {
     21: ([("Cheetah", 180), ("Leopard", 180), ("Hyena", 180)],
          [("right of", "Lion", ("Giraffe",), "#21"), ("past", "Giraffe", ("Hyena",), "#21")]),
     29: ([("Photo gallery", 90), ("Arctic Frontier", 90), ("Outback Adventure", 0), ("Snake House", -90)], []),
-    36: ([], [("near", "Cobra", ("#36",), "#36"), ("past", "Anaconda", ("Cobra",), "#36")]),
+    36: ([("Cobra", 0)], [("near", "Cobra", ("#36",), "#36"), ("past", "Anaconda", ("Cobra",), "#36")]),
 }
 
 
