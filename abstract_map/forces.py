@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+_DENSE_LIMIT = 250_000  # masses x pairs up to which forces are summed with a dense incidence matrix
+
 EXPANSION_LAWS: dict[str, Callable[[float, np.ndarray], np.ndarray]] = {
     "constant": lambda c, r: np.full_like(r, c),  # N
     "proportional": lambda c, r: c * r,  # N/m times m
@@ -40,7 +42,7 @@ class ForceField:
     a spring's error is the angle of its second pair minus that of its first
     (a global spring's first pair is the x axis). Each head is pushed along its
     pair's tangent and the tail takes the reaction, so one gather and one
-    incidence product give every force.
+    incidence product (bincounts for large systems) give every force.
     """
 
     n: int
@@ -64,18 +66,20 @@ class ForceField:
         heads = np.concatenate([self.g_fig, self.r_a, self.r_b]).astype(int)
         tails = np.concatenate([self.g_ref, self.r_vertex, self.r_vertex]).astype(int)
         n_pairs = len(heads)
-        incidence = np.zeros((self.n, n_pairs))
-        np.add.at(incidence, (heads, np.arange(n_pairs)), 1.0)
-        np.add.at(incidence, (tails, np.arange(n_pairs)), -1.0)
         # Spring s measures angle(pair second[s]) - angle(pair first[s]); index n_pairs is the x axis.
         first = np.concatenate([np.full(n_g, n_pairs), n_g + np.arange(n_r)]).astype(int)
         second = np.concatenate([np.arange(n_g), n_g + n_r + np.arange(n_r)]).astype(int)
-        # Pair force = sign x spring torque-force: the second pair is pushed back (-), the first forward (+).
-        sign = np.zeros((n_pairs + 1, n_g + n_r))
-        sign[second, np.arange(n_g + n_r)] = -1.0
-        sign[first, np.arange(n_g + n_r)] += 1.0
-        fields = {"_heads": heads, "_tails": tails, "_incidence": incidence, "_first": first, "_second": second,
-                  "_sign": sign[:n_pairs], "_target": np.concatenate([self.g_angle, self.r_angle]),
+        # Each pair serves one spring: its second pair is pushed back (-1), its first forward (+1).
+        pair_spring = np.concatenate([np.arange(n_g), n_g + np.arange(n_r), n_g + np.arange(n_r)]).astype(int)
+        pair_sign = np.concatenate([-np.ones(n_g), np.ones(n_r), -np.ones(n_r)])
+        incidence = None
+        if self.n * n_pairs <= _DENSE_LIMIT:  # small systems: one matrix product beats two bincounts
+            incidence = np.zeros((self.n, n_pairs))
+            np.add.at(incidence, (heads, np.arange(n_pairs)), 1.0)
+            np.add.at(incidence, (tails, np.arange(n_pairs)), -1.0)
+        fields = {"_heads": heads, "_tails": tails, "_ends": np.concatenate([heads, tails]), "_incidence": incidence,
+                  "_first": first, "_second": second,
+                  "_pair_spring": pair_spring, "_pair_sign": pair_sign, "_target": np.concatenate([self.g_angle, self.r_angle]),
                   "_k": np.concatenate([self.g_k, self.r_k])}
         for name, value in fields.items():
             object.__setattr__(self, name, value)
@@ -91,8 +95,14 @@ class ForceField:
             first, second = self._first, self._second  # type: ignore[attr-defined]
             error = wrap(angle[second] - angle[first] - self._target)  # type: ignore[attr-defined]
             spring = self._k * error * gain[first] * gain[second]  # type: ignore[attr-defined]
-            push = (self._sign @ spring) / np.maximum(length, 1e-9) * 1j * d  # type: ignore[attr-defined]
-            forces = self._incidence @ push  # type: ignore[attr-defined]
+            scale = self._pair_sign * spring[self._pair_spring] / np.maximum(length, 1e-9)  # type: ignore[attr-defined]
+            push = scale * 1j * d
+            if self._incidence is not None:  # type: ignore[attr-defined]
+                forces = self._incidence @ push  # type: ignore[attr-defined]
+            else:
+                both = np.concatenate([push, -push])  # heads pushed, tails take the reaction
+                ends = self._ends  # type: ignore[attr-defined]
+                forces = np.bincount(ends, both.real, self.n) + 1j * np.bincount(ends, both.imag, self.n)
         else:
             forces = np.zeros(self.n, dtype=complex)
         if self.centre is not None and len(self.expand) and self.expansion != 0.0:
