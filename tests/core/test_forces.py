@@ -30,7 +30,7 @@ def test_relative_angle_turns_the_figure_and_balances():
     # angle at vertex 1 from a=0 to b=2 wants pi; b sits at 90 degrees
     pos = np.array([-2.0 + 0j, 0.0, 2.0j])
     f = field(3, r=[(0, 1, 2, math.pi, 1.0)])(pos)
-    assert f[2].real < 0  # b is turned toward -x, away from a
+    assert f[2].real > 0  # b is turned toward +x, away from a at -x
     assert f.sum() == pytest.approx(0.0)
 
 
