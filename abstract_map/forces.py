@@ -79,7 +79,8 @@ class ForceField:
             np.add.at(incidence, (tails, np.arange(n_pairs)), -1.0)
         fields = {"_heads": heads, "_tails": tails, "_ends": np.concatenate([heads, tails]), "_incidence": incidence,
                   "_first": first, "_second": second,
-                  "_pair_spring": pair_spring, "_pair_sign": pair_sign, "_target": np.concatenate([self.g_angle, self.r_angle]),
+                  "_pair_spring": pair_spring, "_pair_sign": pair_sign,
+                  "_target": np.concatenate([self.g_angle, self.r_angle]),
                   "_k": np.concatenate([self.g_k, self.r_k])}
         for name, value in fields.items():
             object.__setattr__(self, name, value)

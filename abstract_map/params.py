@@ -27,8 +27,10 @@ class ScaleDefaults:
     """
 
     place: dict[LevelPair, float] = field(default_factory=_place_scales)  # m, by (level a <= level b)
-    sign: dict[int, float] = field(default_factory=lambda: {1: 8.0, 2: 15.0, 3: 20.0})  # m, place to sign, by place level
-    label: dict[int, float] = field(default_factory=lambda: {1: 2.0, 2: 12.5, 3: 20.0})  # m, place to its label, never learned
+    # m, place to sign, by place level (the authors' 8 and 15; level 3 takes the label's 20)
+    sign: dict[int, float] = field(default_factory=lambda: {1: 8.0, 2: 15.0, 3: 20.0})
+    # m, place to its own label, by place level; never learned
+    label: dict[int, float] = field(default_factory=lambda: {1: 2.0, 2: 12.5, 3: 20.0})
 
 
 @dataclass(frozen=True)

@@ -160,8 +160,12 @@ def _record(model: AbstractMap, report: SettleReport, label: str) -> dict[str, A
             "goal": goal}
 
 
+Progress = Callable[[int, int, dict[str, Any]], None]
+"""Called after each settle with (step, steps, record)."""
+
+
 def replay(scenario: Scenario, *, params: AbstractMapParams | None = None,
-           progress: Callable[[int, int, dict[str, Any]], None] | None = None) -> tuple[AbstractMap, list[dict[str, Any]]]:
+           progress: Progress | None = None) -> tuple[AbstractMap, list[dict[str, Any]]]:
     """Settle after the hierarchy and after every step; one record per settle."""
     model = AbstractMap.from_hierarchy(scenario.hierarchy, scenario.start, goal=scenario.goal, params=params)
     visited = [np.array(scenario.start[:2])]

@@ -9,8 +9,8 @@ planning checks use :func:`grid_caster` over a boolean occupancy image.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 

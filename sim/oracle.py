@@ -17,7 +17,7 @@ import numpy as np
 from scipy import ndimage
 from skimage.graph import MCP_Geometric
 
-from .world_data import Tag, World
+from .world_data import Floorplan, Tag, World
 
 
 @dataclass(frozen=True)
@@ -38,39 +38,26 @@ class OraclePath:
     path: np.ndarray  # (N, 2) m, world frame, start to reading pose
 
 
-def _pooled(world: World, cell_m: float) -> tuple[np.ndarray, float]:
+def pooled_floorplan(world: World, cell_m: float) -> Floorplan:
+    """The floor plan max-pooled to cells of about ``cell_m`` (m); the origin is unchanged."""
     factor = max(1, round(cell_m / world.floorplan.resolution))
     occ = world.floorplan.occupied
     rows, cols = (occ.shape[0] // factor) * factor, (occ.shape[1] // factor) * factor
-    # Crop from the top so the bottom-left origin is unchanged.
-    occ = occ[occ.shape[0] - rows:, :cols]
+    occ = occ[occ.shape[0] - rows:, :cols]  # crop from the top, keeping the bottom-left origin
     pooled = occ.reshape(rows // factor, factor, cols // factor, factor).any(axis=(1, 3))
-    return pooled, world.floorplan.resolution * factor
+    return Floorplan(pooled, world.floorplan.resolution * factor, world.floorplan.origin)
 
 
-def _world_to_cell(xy: np.ndarray, origin: tuple[float, float], res: float, rows: int) -> np.ndarray:
-    col = np.floor((xy[..., 0] - origin[0]) / res).astype(int)
-    row = rows - 1 - np.floor((xy[..., 1] - origin[1]) / res).astype(int)
-    return np.stack([row, col], axis=-1)
-
-
-def _cell_to_world(rc: np.ndarray, origin: tuple[float, float], res: float, rows: int) -> np.ndarray:
-    x = origin[0] + (rc[..., 1] + 0.5) * res
-    y = origin[1] + (rows - 1 - rc[..., 0] + 0.5) * res
-    return np.stack([x, y], axis=-1)
-
-
-def readable_cells(world: World, tag: Tag, occupied: np.ndarray, res: float,
-                   params: OracleParams) -> np.ndarray:
-    """Boolean mask of cells from which ``tag`` can be read (range, cone, line of sight)."""
+def readable_cells(plan: Floorplan, tag: Tag, params: OracleParams) -> np.ndarray:
+    """Boolean mask over ``plan`` of cells from which ``tag`` can be read (range, cone, line of sight)."""
+    occupied, res = plan.occupied, plan.resolution
     rows, cols = occupied.shape
-    origin = world.floorplan.origin
     r = int(math.ceil(params.read_range_m / res))
-    centre = _world_to_cell(np.array([tag.x, tag.y]), origin, res, rows)
+    centre = plan.world_to_pixel(np.array([tag.x, tag.y]))[0]
     r0, r1 = max(0, centre[0] - r), min(rows, centre[0] + r + 1)
     c0, c1 = max(0, centre[1] - r), min(cols, centre[1] + r + 1)
     rr, cc = np.mgrid[r0:r1, c0:c1]
-    xy = _cell_to_world(np.stack([rr, cc], axis=-1), origin, res, rows)
+    xy = plan.pixel_to_world(np.stack([rr.ravel(), cc.ravel()], axis=1)).reshape(*rr.shape, 2)
     d = xy - np.array([tag.x, tag.y])
     dist = np.hypot(d[..., 0], d[..., 1])
     normal = np.array([math.cos(tag.theta), math.sin(tag.theta)])
@@ -84,7 +71,7 @@ def readable_cells(world: World, tag: Tag, occupied: np.ndarray, res: float,
     # and are drawn inside, their own wall) to the candidate cell.
     front = np.array([tag.x, tag.y])
     for step in np.arange(0.0, 0.5, 0.5 * res):
-        ahead = _world_to_cell(front + step * normal, origin, res, rows)
+        ahead = plan.world_to_pixel(front + step * normal)[0]
         if 0 <= ahead[0] < rows and 0 <= ahead[1] < cols and not occupied[ahead[0], ahead[1]]:
             front = front + step * normal
             break
@@ -92,7 +79,7 @@ def readable_cells(world: World, tag: Tag, occupied: np.ndarray, res: float,
     n = int(math.ceil(params.read_range_m / (0.5 * res))) + 1
     s = np.linspace(0.0, 1.0, n)[None, :, None]
     pts = front[None, None, :] + s * (ends[:, None, :] - front[None, None, :])
-    prc = _world_to_cell(pts, origin, res, rows)
+    prc = plan.world_to_pixel(pts.reshape(-1, 2)).reshape(*pts.shape[:2], 2)
     prc[..., 0] = np.clip(prc[..., 0], 0, rows - 1)
     prc[..., 1] = np.clip(prc[..., 1], 0, cols - 1)
     clear = ~occupied[prc[..., 0], prc[..., 1]].any(axis=1)
@@ -108,19 +95,18 @@ def oracle_path(world: World, goal: str, start: tuple[float, float] | None = Non
     tags = world.label_tags(goal)
     if not tags:
         raise ValueError(f"goal {goal!r}: no label tag in world {world.name!r}")
-    occupied, res = _pooled(world, params.cell_m)
-    rows = occupied.shape[0]
-    free = ndimage.distance_transform_edt(~occupied) * res > params.robot_radius_m
+    grid = pooled_floorplan(world, params.cell_m)
+    free = ndimage.distance_transform_edt(~grid.occupied) * grid.resolution > params.robot_radius_m
     costs = np.where(free, 1.0, np.inf)
     start_xy = np.array(start if start is not None else world.start[:2], dtype=float)
-    start_rc = tuple(_world_to_cell(start_xy, world.floorplan.origin, res, rows))
+    start_rc = tuple(grid.world_to_pixel(start_xy)[0])
     if not free[start_rc]:
         raise ValueError(f"oracle: the start {tuple(start_xy)} is within the robot's radius of a wall")
     mcp = MCP_Geometric(costs)
     cumulative, _ = mcp.find_costs([start_rc])
     best: tuple[float, Tag, tuple[int, int]] | None = None
     for tag in tags:
-        readable = readable_cells(world, tag, occupied, res, params) & free
+        readable = readable_cells(grid, tag, params) & free
         if not readable.any():
             continue
         cells = np.argwhere(readable)
@@ -131,6 +117,6 @@ def oracle_path(world: World, goal: str, start: tuple[float, float] | None = Non
     if best is None:
         raise ValueError(f"oracle: no reachable pose reads the label of {goal!r}")
     cost, tag, end = best
-    path = _cell_to_world(np.array(mcp.traceback(end)), world.floorplan.origin, res, rows)
+    path = grid.pixel_to_world(np.array(mcp.traceback(end)))
     length = float(np.hypot(*np.diff(path, axis=0).T).sum())
     return OraclePath(goal, tag.id, length, path)

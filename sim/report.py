@@ -64,6 +64,10 @@ def _fmt(value: float, spec: str = ".1f") -> str:
     return "-" if value is None or math.isnan(value) else format(value, spec)
 
 
+def _ratio(ours: float, oracle: float) -> str:
+    return "-" if math.isnan(oracle) or math.isnan(ours) else f"{ours / oracle:.2f}"
+
+
 def _improvement(ours: float, theirs: float) -> float:
     return (1.0 - ours / theirs) * 100.0 if theirs and not math.isnan(ours) else math.nan
 
@@ -88,7 +92,7 @@ def report_markdown(world: World, rows: list[GoalRow], *, perception: str, trial
         ok = f"{len(row.ours)}/{len(row.ours) + row.failures}"
         lines.append(f"| {row.goal} | {_fmt(human)} | {_fmt(robot)} | {_fmt(ours)} | {_fmt(spread)} | {ok} | "
                      f"{_fmt(_improvement(ours, human))} | {_fmt(_improvement(ours, robot))} | {_fmt(oracle)} | "
-                     f"{_fmt(ours / oracle, '.2f') if oracle == oracle else '-'} |")
+                     f"{_ratio(ours, oracle)} |")
         for key, value in (("human", human), ("robot", robot), ("ours", ours), ("oracle", oracle)):
             totals[key].append(value)
     overall = {k: float(np.mean(v)) if v and not any(math.isnan(x) for x in v) else math.nan
@@ -96,7 +100,7 @@ def report_markdown(world: World, rows: list[GoalRow], *, perception: str, trial
     lines.append(f"| **overall** | {_fmt(overall['human'])} | {_fmt(overall['robot'])} | {_fmt(overall['ours'])} | "
                  f"| | {_fmt(_improvement(overall['ours'], overall['human']))} | "
                  f"{_fmt(_improvement(overall['ours'], overall['robot']))} | {_fmt(overall['oracle'])} | "
-                 f"{_fmt(overall['ours'] / overall['oracle'], '.2f') if overall['oracle'] == overall['oracle'] else '-'} |")
+                 f"{_ratio(overall['ours'], overall['oracle'])} |")
     failures = [row for row in rows if row.failures]
     if failures:
         lines += ["", "Failed trials are left out of the means: " +
@@ -120,8 +124,8 @@ def comparison_plot(rows: list[GoalRow], path: str | os.PathLike[str]) -> None:
         for j, (name, values) in enumerate(series.items()):
             if not values:
                 continue
-            box = ax.boxplot([values], positions=[base + 1 - j], orientation="horizontal", widths=0.7, patch_artist=True,
-                             whis=(0, 100))
+            box = ax.boxplot([values], positions=[base + 1 - j], orientation="horizontal", widths=0.7,
+                             patch_artist=True, whis=(0, 100))
             box["boxes"][0].set(facecolor=colours[name], alpha=0.35, edgecolor=colours[name])
         if row.oracle_m is not None:
             ax.plot([row.oracle_m] * 2, [base - 1.5, base + 1.5], color="black", ls="--", lw=1.2)

@@ -13,7 +13,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
 import pybullet as p
 
 from sim.scene import ROBOT_GROUP, ROBOT_MASK, Scene

@@ -28,7 +28,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
 import pybullet as p
 
 from sim.world_data import Tag, World
@@ -296,7 +295,7 @@ class Scene:
         self._add_decor(_rect_quads(np.array([[x_min, x_max, y_min, y_max]]), 0.0), self.params.floor_rgba)
 
     def _build_walls(self) -> None:
-        fp, cid, params = self.world.floorplan, self.client, self.params
+        fp, params = self.world.floorplan, self.params
         self._pool = max(1, round(params.wall_cell_m / fp.resolution))
         self._grid = pool_occupancy(fp.occupied, self._pool)
         cell = self._pool * fp.resolution

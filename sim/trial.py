@@ -21,7 +21,7 @@ from .laser import LaserParams, laser_angles, scan
 from .navigator import CueEvent, Navigator, NavigatorParams
 from .occupancy import OccupancyGrid, OccupancyParams
 from .perception import GeometricParams, make_perception
-from .planner import PlannerParams, ReplanParams, Replanner
+from .planner import PlannerParams, Replanner, ReplanParams
 from .robot import Robot, RobotParams
 from .scene import build_scene
 from .targeting import Target, TargetParams, choose_target

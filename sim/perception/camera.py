@@ -23,7 +23,6 @@ from types import MappingProxyType
 
 import cv2
 import numpy as np
-
 import pybullet as p
 
 from sim.perception.sighting import Sighting, readable

@@ -30,11 +30,11 @@ def test_oracle_from_behind_the_wall_goes_around_it(tiny_world):
 
 
 def test_readable_cells_respect_the_cone_and_range(tiny_world):
-    from sim.oracle import _pooled
+    from sim.oracle import pooled_floorplan
 
-    occupied, res = _pooled(tiny_world, 0.05)
-    mask = readable_cells(tiny_world, tiny_world.tags[0], occupied, res, OracleParams())
-    rows = occupied.shape[0]
+    plan = pooled_floorplan(tiny_world, 0.05)
+    mask = readable_cells(plan, tiny_world.tags[0], OracleParams())
+    rows, res = plan.occupied.shape[0], plan.resolution
     cells = np.argwhere(mask)
     x = (cells[:, 1] + 0.5) * res
     y = (rows - 1 - cells[:, 0] + 0.5) * res
