@@ -71,12 +71,20 @@ class Navigator:
         nav.settles.append(model.settle())
         return nav
 
-    def target(self) -> np.ndarray:
-        """Where to drive (m): the goal's imagined position, clamped into the map's bounds."""
+    def target(self, robot_xy: np.ndarray | None = None) -> np.ndarray:
+        """Where to drive (m): the goal's imagined position, brought inside the map's bounds.
+
+        A goal imagined off the map is brought back along the line from the robot
+        (when given) to where that line leaves the map, so the robot still heads
+        its way; without a robot position each coordinate is clamped.
+        """
         x_min, x_max, y_min, y_max = self.world.floorplan.extent
         m = self.params.bounds_margin_m
+        low, high = np.array([x_min + m, y_min + m]), np.array([x_max - m, y_max - m])
         goal = self.model.goal_estimate()
-        return np.array([np.clip(goal[0], x_min + m, x_max - m), np.clip(goal[1], y_min + m, y_max - m)])
+        if robot_xy is not None and np.all((low <= robot_xy) & (robot_xy <= high)):
+            return clip_segment(np.asarray(robot_xy, dtype=float), goal, low, high)
+        return np.clip(goal, low, high)
 
     def _is_goal_label(self, tag: Tag) -> bool:
         return tag.kind == "label" and self.model.canonical(tag.text) == self.goal
@@ -122,3 +130,15 @@ class Navigator:
         log.info("goal not where imagined: exploration factor %.3f", factor)
         self.settle(explored_centre)
         return True
+
+
+def clip_segment(start: np.ndarray, end: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """The point where the segment from ``start`` (inside the box) to ``end`` leaves the box, or ``end``."""
+    direction = end - start
+    t = 1.0
+    for axis in range(2):
+        if direction[axis] > 0:
+            t = min(t, (high[axis] - start[axis]) / direction[axis])
+        elif direction[axis] < 0:
+            t = min(t, (low[axis] - start[axis]) / direction[axis])
+    return start + max(0.0, t) * direction

@@ -192,7 +192,8 @@ def _loop(world: World, goal: str, scene: Any, start: tuple[float, float, float]
         # A stand-in target is kept until the model changes; the imagined goal is re-checked as the map grows.
         if target is None or (not target.local and t - target_at >= params.target_recheck_s):
             detours = nav.bumps_in_a_row >= params.targeting.local_bumps
-            target = choose_target(grid, np.array(pose[:2]), nav.target(), params.planner, params.targeting,
+            robot_xy = np.array(pose[:2])
+            target = choose_target(grid, robot_xy, nav.target(robot_xy), params.planner, params.targeting,
                                    allow_detours=detours)
             target_at = t
         v = w = 0.0

@@ -58,3 +58,12 @@ def test_unknown_goal_is_an_error(tiny_world):
 
     with pytest.raises(UnknownPlaceError, match="Narnia"):
         Navigator.start(tiny_world, "Narnia", tiny_world.start)
+
+
+def test_a_goal_off_the_map_is_brought_back_along_the_line_from_the_robot():
+    from sim.navigator import clip_segment
+
+    low, high = np.array([0.0, 0.0]), np.array([10.0, 8.0])
+    assert np.allclose(clip_segment(np.array([2.0, 2.0]), np.array([4.0, 14.0]), low, high), [3.0, 8.0])
+    assert np.allclose(clip_segment(np.array([2.0, 2.0]), np.array([5.0, 5.0]), low, high), [5.0, 5.0])
+    assert np.allclose(clip_segment(np.array([9.0, 1.0]), np.array([13.0, -3.0]), low, high), [10.0, 0.0])
