@@ -6,6 +6,7 @@ Where the paper and the authors' code disagree, the field says which is used.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 STIFFNESS: dict[str, float] = {"XL": 2.5, "L": 1.0, "M": 0.5, "S": 0.1, "XS": 0.01}
@@ -49,6 +50,14 @@ class DynamicsParams:
     settle_velocity: float = 0.1  # m/s, L_v
     max_iterations: int = 5000  # steps before settle() gives up and reports "not settled"
 
+    def __post_init__(self) -> None:
+        _choice("DynamicsParams.expansion_law", self.expansion_law, ("constant", "proportional"))
+        _choice("DynamicsParams.expansion_on", self.expansion_on, ("leaves", "all"))
+        for name in ("mass", "dt", "settle_acceleration", "settle_velocity", "max_iterations"):
+            _positive(f"DynamicsParams.{name}", getattr(self, name))
+        for name in ("friction", "expansion", "min_separation", "angle_core"):
+            _positive(f"DynamicsParams.{name}", getattr(self, name), allow_zero=True)
+
 
 @dataclass(frozen=True)
 class ExplorationParams:
@@ -56,6 +65,10 @@ class ExplorationParams:
 
     step: float = 0.25  # 25 % per bump
     law: str = "multiplicative"  # "multiplicative" (paper: E *= 1 + step) or "additive" (authors: E += step)
+
+    def __post_init__(self) -> None:
+        _choice("ExplorationParams.law", self.law, ("multiplicative", "additive"))
+        _positive("ExplorationParams.step", self.step)
 
 
 @dataclass(frozen=True)
@@ -67,3 +80,16 @@ class AbstractMapParams:
     exploration: ExplorationParams = field(default_factory=ExplorationParams)
     start_stiffness: str = "S"  # the start pose's pull on the hierarchy root(s), a STIFFNESS name
     between_angle: bool = True  # add the relative angle of pi at the figure between two referents
+
+    def __post_init__(self) -> None:
+        _choice("AbstractMapParams.start_stiffness", self.start_stiffness, tuple(STIFFNESS))
+
+
+def _choice(name: str, value: str, allowed: tuple[str, ...]) -> None:
+    if value not in allowed:
+        raise ValueError(f"{name} is {value!r}; expected one of {list(allowed)}")
+
+
+def _positive(name: str, value: float, *, allow_zero: bool = False) -> None:
+    if not (math.isfinite(value) and (value >= 0 if allow_zero else value > 0)):
+        raise ValueError(f"{name} must be finite and {'>= 0' if allow_zero else '> 0'}, got {value!r}")

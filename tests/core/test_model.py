@@ -13,6 +13,7 @@ import pytest
 from abstract_map import persistence
 from abstract_map.grammar import CueError
 from abstract_map.model import UnknownPlaceError
+from abstract_map.params import AbstractMapParams, DynamicsParams, ExplorationParams
 from abstract_map.scenario import load_scenario, replay
 
 from .helpers import make_map, settle
@@ -163,3 +164,14 @@ def test_picture_is_written(tmp_path):
     settle(model)
     save_picture(model, tmp_path / "map.png")
     assert (tmp_path / "map.png").stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("cls, kwargs, match", [
+    (DynamicsParams, {"expansion_law": "cubic"}, "expansion_law"),
+    (DynamicsParams, {"dt": 0.0}, "dt"),
+    (ExplorationParams, {"law": "exponential"}, "law"),
+    (AbstractMapParams, {"start_stiffness": "XXL"}, "start_stiffness"),
+])
+def test_bad_parameters_are_named(cls, kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        cls(**kwargs)
