@@ -19,7 +19,7 @@ import numpy as np
 _DENSE_LIMIT = 250_000  # masses x pairs up to which forces are summed with a dense incidence matrix
 
 EXPANSION_LAWS: dict[str, Callable[[float, np.ndarray], np.ndarray]] = {
-    "constant": lambda c, r: np.full_like(r, c),  # N
+    "constant": lambda c, r: c,  # N, the same for every mass
     "proportional": lambda c, r: c * r,  # N/m times m
 }
 
@@ -81,6 +81,8 @@ class ForceField:
                   "_first": first, "_second": second,
                   "_pair_spring": pair_spring, "_pair_sign": pair_sign,
                   "_target": np.concatenate([self.g_angle, self.r_angle]),
+                  # scratch: pair angles and fade gains, the extra last entry being the x axis (angle 0, gain 1)
+                  "_angle": np.zeros(n_pairs + 1), "_gain": np.ones(n_pairs + 1),
                   "_k": np.concatenate([self.g_k, self.r_k])}
         for name, value in fields.items():
             object.__setattr__(self, name, value)
@@ -91,8 +93,12 @@ class ForceField:
         if len(heads):
             d = z[heads] - z[self._tails]  # type: ignore[attr-defined]
             length = np.abs(d)
-            angle = np.append(np.angle(d), 0.0)
-            gain = np.append(np.minimum(1.0, length / self.core) if self.core > 0 else 1.0 * (length > 0), 1.0)
+            angle, gain = self._angle, self._gain  # type: ignore[attr-defined]
+            np.arctan2(d.imag, d.real, out=angle[:-1])
+            if self.core > 0:
+                np.minimum(1.0, length / self.core, out=gain[:-1])
+            else:
+                gain[:-1] = length > 0
             first, second = self._first, self._second  # type: ignore[attr-defined]
             error = wrap(angle[second] - angle[first] - self._target)  # type: ignore[attr-defined]
             spring = self._k * error * gain[first] * gain[second]  # type: ignore[attr-defined]

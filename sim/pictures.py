@@ -47,7 +47,7 @@ def draw_tags(ax: Axes, world: World, read: Sequence[int] = (), goal_tags: Seque
             ax.annotate(str(tag.id), (tag.x, tag.y), fontsize=7, xytext=(3, 3), textcoords="offset points")
 
 
-def draw_path(ax: Axes, trajectory: np.ndarray, *, colour: str = "tab:blue", label: str | None = None) -> None:
+def draw_path(ax: Axes, trajectory: np.ndarray, *, colour: Any = "tab:blue", label: str | None = None) -> None:
     """A trajectory (N, >=3: t, x, y, ...) with its start circled and its end crossed."""
     ax.plot(trajectory[:, 1], trajectory[:, 2], color=colour, lw=1.8, label=label, zorder=4)
     ax.plot(trajectory[0, 1], trajectory[0, 2], "o", mfc="none", mec=colour, ms=10, mew=2, zorder=5)

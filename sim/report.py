@@ -158,10 +158,12 @@ def path_pictures(world: World, records: list[dict[str, Any]], oracles: dict[str
         fig, ax = plt.subplots(figsize=(12, 7.5))
         draw_floorplan(ax, world)
         draw_tags(ax, world, goal_tags=[t.id for t in world.label_tags(goal)])
-        for record in (r for r in records if r["goal"] == goal and r.get("trajectory")):
-            colour = "tab:blue" if record["success"] else "tab:red"
-            draw_path(ax, np.array(record["trajectory"]), colour=colour,
-                      label=f"seed {record['seed']}: {record['distance_m']:.1f} m")
+        mine = [r for r in records if r["goal"] == goal and r.get("trajectory")]
+        palette = plt.get_cmap("viridis")(np.linspace(0.1, 0.85, max(1, len(mine))))
+        for record, colour in zip(mine, palette):
+            verdict = f"{record['distance_m']:.1f} m" if record["success"] else "failed"
+            draw_path(ax, np.array(record["trajectory"]), colour="tab:red" if not record["success"] else colour,
+                      label=f"seed {record['seed']}: {verdict}")
         if goal in oracles:
             oracle = oracles[goal].path
             ax.plot(oracle[:, 0], oracle[:, 1], color="black", ls="--", lw=1.5,
