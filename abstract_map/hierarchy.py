@@ -58,7 +58,13 @@ class Hierarchy:
         return [c for c in self.places if self.parent.get(c) == name]
 
     def roots(self) -> list[str]:
-        return [p for p in self.places if p not in self.parent and self.children(p)]
+        parents = set(self.parent.values())
+        return [p for p in self.places if p not in self.parent and p in parents]
+
+    def leaves(self) -> list[str]:
+        """Places with no children, in document order."""
+        parents = set(self.parent.values())
+        return [p for p in self.places if p not in parents]
 
     def levels(self) -> dict[str, int]:
         """Level of every place: leaves 1, a parent one above its highest child."""
@@ -76,16 +82,18 @@ class Hierarchy:
             visit(name)
         return level
 
-    def is_leaf(self, name: str) -> bool:
-        return not self.children(name)
-
     def clauses(self) -> list[Relational]:
         """The hierarchy as "X is in Y" clauses, in document order."""
         return [Relational("in", c, (self.parent[c],)) for c in self.places if c in self.parent]
 
     def to_nested(self) -> dict[str, Any]:
+        kids: dict[str, list[str]] = {p: [] for p in self.places}
+        for child in self.places:
+            if child in self.parent:
+                kids[self.parent[child]].append(child)
+
         def nest(name: str) -> dict[str, Any]:
-            return {c: nest(c) for c in self.children(name)}
+            return {c: nest(c) for c in kids[name]}
 
         return {r: nest(r) for r in self.places if r not in self.parent}
 

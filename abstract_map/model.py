@@ -137,22 +137,25 @@ class AbstractMap:
         out.extend(self.loose_clauses)
         return out
 
-    def canonical(self, name: str) -> str:
+    def _name_index(self) -> dict[str, str]:
+        """Case-folded place name -> the spelling first used."""
+        index: dict[str, str] = {}
+        for place in self.places():
+            index.setdefault(place.casefold(), place)
+        return index
+
+    def canonical(self, name: str, index: Mapping[str, str] | None = None) -> str:
         """A known place's spelling for ``name`` (case-insensitive), else ``name`` itself."""
         if name in self.positions or is_anchor(name):
             return name
-        folded = name.casefold()
-        for known in self.places():
-            if known.casefold() == folded:
-                return known
-        return name
+        return (index if index is not None else self._name_index()).get(name.casefold(), name)
 
-    def _canonical_clause(self, clause: Clause) -> Clause:
+    def _canonical_clause(self, clause: Clause, index: Mapping[str, str]) -> Clause:
         if isinstance(clause, Relational):
-            context = clause.context and self.canonical(clause.context)
-            return Relational(clause.preposition, self.canonical(clause.figure),
-                              tuple(self.canonical(r) for r in clause.referents), context)
-        return Locational(clause.kind, self.canonical(clause.toponym), clause.anchor, clause.direction)
+            context = clause.context and self.canonical(clause.context, index)
+            return Relational(clause.preposition, self.canonical(clause.figure, index),
+                              tuple(self.canonical(r, index) for r in clause.referents), context)
+        return Locational(clause.kind, self.canonical(clause.toponym, index), clause.anchor, clause.direction)
 
     def _check_clause(self, clause: Clause) -> None:
         if isinstance(clause, Relational) and clause.preposition not in TABLE:
@@ -167,8 +170,9 @@ class AbstractMap:
         "X is in Y" clauses also extend the hierarchy. A new clause resets exploration.
         """
         added = []
+        index = self._name_index()
         for clause in clauses:
-            clause = self._canonical_clause(clause)
+            clause = self._canonical_clause(clause, index)
             self._check_clause(clause)
             if clause in self.loose_clauses:
                 continue
@@ -207,7 +211,8 @@ class AbstractMap:
                 raise CueError(f"tag {tag_id}: text {text!r} differs from its earlier reading {point.text!r}")
             point.add_sighting(x, y, theta)
         try:
-            clauses = [self._canonical_clause(c) for c in
+            index = self._name_index()
+            clauses = [self._canonical_clause(c, index) for c in
                        parse_cue(point.text, Anchor(name, point.x, point.y, point.theta), kind=point.kind)]
             for clause in clauses:
                 self._check_clause(clause)
@@ -245,13 +250,20 @@ class AbstractMap:
         levels = self.hierarchy.levels()
         return {p: levels.get(p, 1) for p in self.places()}
 
+    def observed_positions(self) -> dict[str, np.ndarray]:
+        """Every fixed point's position, and each observed place's (the mean of its label tags)."""
+        labels: dict[str, list[np.ndarray]] = {}
+        for clauses in self.cue_clauses.values():
+            for c in clauses:
+                if isinstance(c, Locational) and c.kind == "label":
+                    labels.setdefault(c.toponym, []).append(self.fixed[c.anchor].xy)
+        observed = {name: np.mean(xy, axis=0) for name, xy in labels.items()}
+        observed.update({name: f.xy for name, f in self.fixed.items()})
+        return observed
+
     def observed_position(self, name: str) -> np.ndarray | None:
         """Where a place was observed (mean of its label tags), a fixed point's position, or None."""
-        if name in self.fixed:
-            return self.fixed[name].xy
-        labels = [self.fixed[c.anchor].xy for clauses in self.cue_clauses.values() for c in clauses
-                  if isinstance(c, Locational) and c.kind == "label" and c.toponym == name]
-        return np.mean(labels, axis=0) if labels else None
+        return self.observed_positions().get(name)
 
     def is_observed(self, place: str) -> bool:
         """True once a label of ``place`` has been read."""
@@ -259,13 +271,13 @@ class AbstractMap:
 
     def scale_factors(self) -> dict[ScaleKey, float]:
         """Learned scale factors (m per unit) by key; defaults are not listed."""
-        return learn_scales(self.springs(), self.levels(), self.observed_position)
+        return learn_scales(self.springs(), self.levels(), self.observed_positions().get)
 
     def resolved_springs(self) -> list[Resolved]:
         """Springs with natural lengths in metres and angles in radians."""
         levels = self.levels()
         springs = self.springs()
-        learned = learn_scales(springs, levels, self.observed_position)
+        learned = learn_scales(springs, levels, self.observed_positions().get)
         out = []
         for s in springs:
             value = (natural_length(s, levels, learned, self.params.scales, self.exploration_factor)
@@ -327,7 +339,8 @@ class AbstractMap:
         for name, xy in placed.items():
             self.positions[name] = xy
             self.velocities[name] = np.zeros(2)
-        leaves = [p for p in places if self.hierarchy.is_leaf(p)]
+        parents = set(self.hierarchy.parent.values())
+        leaves = [p for p in places if p not in parents]
         expand = leaves if self.params.dynamics.expansion_on == "leaves" else places
         result = run_dynamics({p: self.positions[p] for p in places}, self.velocities,
                               {n: f.xy for n, f in self.fixed.items()}, springs,

@@ -9,6 +9,7 @@ springs to a single placed neighbour is fanned out ahead of that neighbour
 
 from __future__ import annotations
 
+import heapq
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -55,25 +56,48 @@ def place_new_masses(new: Sequence[str], known: Mapping[str, np.ndarray], spring
                      origin: np.ndarray, heading: float, min_separation: float) -> dict[str, np.ndarray]:
     """Starting positions (m, world) for the masses ``new`` given the ``known`` ones."""
     placed = {name: np.asarray(p, dtype=float) for name, p in known.items()}
-    total = {name: 0.0 for name in new}
+    touching: dict[str, list[Resolved]] = {}
     for spring in springs:
-        for end in spring.ends:
-            if end in total:
-                total[end] += spring.stiffness
+        for end in set(spring.ends):
+            touching.setdefault(end, []).append(spring)
+    total = {name: sum(s.stiffness for s in touching.get(name, [])) for name in new}
     order = sorted(new, key=lambda n: -total[n])  # stable: ties keep first-seen order
+    rank = {name: i for i, name in enumerate(order)}
+    ready: list[int] = []  # ranks of unplaced masses with a spring whose other ends are all placed
+
+    def offer(name: str) -> None:
+        for spring in touching.get(name, []):
+            if all(e in placed for e in spring.ends if e != name):
+                heapq.heappush(ready, rank[name])
+                return
+
+    for name in order:
+        offer(name)
     fan_count: dict[str, int] = {}
     result: dict[str, np.ndarray] = {}
-    while order:
-        name = next((n for n in order if _neighbours(n, springs, placed)), order[0])
-        order.remove(name)
-        position = _best_position(name, springs, placed, fan_count, origin=origin, heading=heading)
-        position = _separate(position, placed, min_separation)
+    points = np.zeros((len(placed) + len(order), 2))  # every placed position, for the separation check
+    points[:len(placed)] = list(placed.values()) if placed else np.zeros((0, 2))
+    count = len(placed)
+    waiting = list(reversed(order))  # for masses with no placed neighbour: the first in order
+    while len(result) < len(order):
+        name = None
+        while ready and name is None:
+            candidate = order[heapq.heappop(ready)]
+            name = None if candidate in result else candidate
+        while name is None:
+            candidate = waiting.pop()
+            name = None if candidate in result else candidate
+        mine = touching.get(name, [])
+        position = _best_position(name, mine, placed, fan_count, origin=origin, heading=heading)
+        position = _separate(position, points[:count], min_separation)
         placed[name] = result[name] = position
+        points[count] = position
+        count += 1
+        for spring in mine:
+            for other in spring.ends:
+                if other in rank and other not in result:
+                    offer(other)
     return result
-
-
-def _neighbours(name: str, springs: Sequence[Resolved], placed: Mapping[str, np.ndarray]) -> bool:
-    return any(name in s.ends and all(e in placed for e in s.ends if e != name) for s in springs)
 
 
 def _length_between(name: str, other: str, springs: Sequence[Resolved], fallback: float) -> float:
@@ -83,6 +107,7 @@ def _length_between(name: str, other: str, springs: Sequence[Resolved], fallback
 
 def _best_position(name: str, springs: Sequence[Resolved], placed: Mapping[str, np.ndarray],
                    fan_count: dict[str, int], *, origin: np.ndarray, heading: float) -> np.ndarray:
+    """Where ``name`` best satisfies ``springs`` (those touching it) to the placed masses."""
     distance = [s for s in springs if s.kind == "distance" and name in s.ends
                 and all(e in placed for e in s.ends if e != name)]
     typical = float(np.mean([s.value for s in distance])) if distance else 1.0
@@ -131,12 +156,11 @@ def _best_position(name: str, springs: Sequence[Resolved], placed: Mapping[str, 
     return _fit_distances(start, points, lengths, weights)
 
 
-def _separate(position: np.ndarray, placed: Mapping[str, np.ndarray], min_separation: float) -> np.ndarray:
-    """Nudge a position so that it keeps ``min_separation`` from every placed mass."""
+def _separate(position: np.ndarray, points: np.ndarray, min_separation: float) -> np.ndarray:
+    """Nudge a position so that it keeps ``min_separation`` (m) from every point of ``points`` (M, 2)."""
     position = position.copy()
     for k in range(16):
-        clash = [p for p in placed.values() if float(np.hypot(*(position - p))) < min_separation]
-        if not clash:
+        if len(points) == 0 or np.hypot(*(points - position).T).min() >= min_separation:
             break
         position = position + min_separation * _unit(_fan_angle(k + 1) * 2.0)
     return position
