@@ -28,7 +28,8 @@ from typing import Any
 
 import numpy as np
 
-from .grammar import parse_cue
+from .clauses import tag_anchor
+from .grammar import Anchor, parse_cue
 from .hierarchy import Hierarchy
 from .model import AbstractMap, SettleReport, imagined_positions
 from .params import AbstractMapParams
@@ -50,6 +51,12 @@ class Step:
     pose: tuple[float, float, float] | None = None  # x m, y m, theta rad
     kind: str | None = None
     explored_centre: tuple[float, float] | None = None
+
+    def anchor(self) -> Anchor | None:
+        """The tag this cue was read on, as a fixed point, or None for a cue with no place."""
+        if self.pose is None or self.tag is None:
+            return None
+        return Anchor(tag_anchor(self.tag), *self.pose)
 
 
 @dataclass
@@ -135,19 +142,11 @@ def _check_goal(scenario: Scenario, where: str) -> None:
         return
     names = {p.casefold() for p in scenario.hierarchy.places}
     for step in scenario.steps:
-        for clause in parse_cue(step.text, None if step.pose is None else _anchor(step), kind=step.kind):
+        for clause in parse_cue(step.text, step.anchor(), kind=step.kind):
             names.update(n.casefold() for n in vars(clause).values() if isinstance(n, str))
             names.update(r.casefold() for r in getattr(clause, "referents", ()))
     if scenario.goal.casefold() not in names:
         raise ScenarioError(f"{where}: goal {scenario.goal!r} is not mentioned by the hierarchy or any step")
-
-
-def _anchor(step: Step):  # type: ignore[no-untyped-def]
-    from .clauses import tag_anchor
-    from .grammar import Anchor
-
-    assert step.pose is not None and step.tag is not None
-    return Anchor(tag_anchor(step.tag), *step.pose)
 
 
 def _record(model: AbstractMap, report: SettleReport, label: str) -> dict[str, Any]:

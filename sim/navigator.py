@@ -10,7 +10,7 @@ when the goal's own label is read. World frame, metres, radians.
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -90,8 +90,11 @@ class Navigator:
         return tag.kind == "label" and self.model.canonical(tag.text) == self.goal
 
     def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
-                explored_centre: tuple[float, float] | None) -> bool:
-        """Feed sightings to the model; settle if any tag was new. True if the model changed."""
+                explored_centre: Callable[[], tuple[float, float] | None]) -> bool:
+        """Feed sightings to the model; settle if any tag was new. True if the model changed.
+
+        ``explored_centre`` is asked (m, world) only when the model settles.
+        """
         new: list[Tag] = []
         for s in sightings:
             tag = self.world.tags.get(s.tag_id)
@@ -105,7 +108,7 @@ class Navigator:
         if not new:
             return False
         self.bumps_in_a_row = 0
-        report = self.settle(explored_centre)
+        report = self.settle(explored_centre())
         for tag in new:
             self.cues.append(CueEvent(tag.id, tag.text, t_s, distance_m, report.settled, report.iterations,
                                       report.wall_s))

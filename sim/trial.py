@@ -174,11 +174,10 @@ def _loop(world: World, goal: str, scene: Any, start: tuple[float, float, float]
     target_at = -math.inf
     while True:
         pose = robot.pose()
-        centre = grid.explored_centre()
         if n % every["map"] == 0:
             grid.integrate(pose, angles, scan(pose, cast, params.laser, rng), params.laser.max_range_m)
         if n % every["see"] == 0:
-            if nav.observe(sensor.observe(robot), t_s=t, distance_m=distance, explored_centre=centre):
+            if nav.observe(sensor.observe(robot), t_s=t, distance_m=distance, explored_centre=grid.explored_centre):
                 target = None
             if nav.succeeded:
                 reason = "goal label read"
@@ -212,7 +211,7 @@ def _loop(world: World, goal: str, scene: Any, start: tuple[float, float, float]
                 if stuck.update(t, pose, commanded=abs(v) > 0.01 or abs(w) > 0.01):
                     recovery.start(t, turn_sign=1.0 if rng.random() < 0.5 else -1.0)
             if arrived:
-                if not nav.arrived_without_goal(centre):
+                if not nav.arrived_without_goal(grid.explored_centre()):
                     reason = "exploration exhausted: the goal was not found where imagined"
                     break
                 bumps += 1

@@ -25,19 +25,19 @@ def test_starts_with_the_goal_imagined_ahead(tiny_world):
 def test_a_sign_moves_the_goal_and_its_label_ends_the_trial(tiny_world):
     nav = Navigator.start(tiny_world, "A", tiny_world.start)
     before = nav.target()
-    assert nav.observe([sighting(tiny_world, 2)], t_s=1.0, distance_m=0.5, explored_centre=(2.0, 2.0))
+    assert nav.observe([sighting(tiny_world, 2)], t_s=1.0, distance_m=0.5, explored_centre=lambda: (2.0, 2.0))
     assert [c.tag_id for c in nav.cues] == [2] and not nav.succeeded
     assert not np.allclose(before, nav.target())
     # the same sign again changes nothing worth a settle
-    assert not nav.observe([sighting(tiny_world, 2)], t_s=2.0, distance_m=0.6, explored_centre=None)
-    nav.observe([sighting(tiny_world, 0)], t_s=3.0, distance_m=1.0, explored_centre=None)
+    assert not nav.observe([sighting(tiny_world, 2)], t_s=2.0, distance_m=0.6, explored_centre=lambda: None)
+    nav.observe([sighting(tiny_world, 0)], t_s=3.0, distance_m=1.0, explored_centre=lambda: None)
     assert nav.succeeded and nav.model.is_observed("A")
 
 
 def test_empty_and_unknown_tags_are_ignored(tiny_world):
     nav = Navigator.start(tiny_world, "A", tiny_world.start)
     assert not nav.observe([sighting(tiny_world, 3), Sighting(99, 0.0, 0.0, 0.0, 1.0)], t_s=0.0,
-                           distance_m=0.0, explored_centre=None)
+                           distance_m=0.0, explored_centre=lambda: None)
     assert nav.cues == []
 
 
@@ -49,7 +49,7 @@ def test_arriving_without_the_goal_bumps_until_exhausted(tiny_world):
     assert nav.model.exploration_factor == pytest.approx(1.25)
     assert nav.arrived_without_goal((2.0, 2.0))
     assert not nav.arrived_without_goal((2.0, 2.0))
-    nav.observe([sighting(tiny_world, 2)], t_s=1.0, distance_m=0.5, explored_centre=None)
+    nav.observe([sighting(tiny_world, 2)], t_s=1.0, distance_m=0.5, explored_centre=lambda: None)
     assert nav.model.exploration_factor == 1.0 and nav.bumps_in_a_row == 0
 
 
