@@ -16,6 +16,8 @@ from typing import Any
 
 import numpy as np
 
+from abstract_map.model import imagined_positions
+
 from .follower import FollowerParams, PathFollower, Recovery, RecoveryParams, StuckDetector, StuckParams
 from .laser import LaserParams, laser_angles, scan
 from .navigator import CueEvent, Navigator, NavigatorParams
@@ -84,11 +86,9 @@ class TrialResult:
     cues: list[CueEvent]
     trajectory: np.ndarray  # (N, 4): t s, x m, y m, theta rad (true pose)
     final_positions: dict[str, tuple[float, float]]
-    fixed_tags: dict[int, tuple[float, float]]
     exploration_bumps: int
     settle_median_ms: float
     frames: list[Frame] = field(default_factory=list, repr=False)
-    grid_image: np.ndarray | None = field(default=None, repr=False)
     grid_extent: tuple[float, float, float, float] | None = None
 
     @property
@@ -172,6 +172,12 @@ def _loop(world: World, goal: str, scene: Any, start: tuple[float, float, float]
     reason = ""
     target: Target | None = None
     target_at = -math.inf
+
+    def snapshot(pose: tuple[float, float, float]) -> Frame:
+        shown = nav.target() if target is None else target.xy
+        return Frame(t, pose, grid.to_image(), dict(imagined_positions(nav.model)), tuple(shown),
+                     None if replanner.plan is None else replanner.plan.waypoints)
+
     while True:
         pose = robot.pose()
         if n % every["map"] == 0:
@@ -229,23 +235,19 @@ def _loop(world: World, goal: str, scene: Any, start: tuple[float, float, float]
         if progress and n % round(1.0 / tick) == 0:
             progress(t, distance, len(nav.cues))
         if record and n % frame_every == 0:
-            shown = nav.target() if target is None else target.xy
-            frames.append(Frame(t, now, grid.to_image(), _places(nav), tuple(shown),
-                                None if replanner.plan is None else replanner.plan.waypoints))
+            frames.append(snapshot(now))
     trajectory.append((t, *robot.true_pose()))
     if record:
-        frames.append(Frame(t, robot.true_pose(), grid.to_image(), _places(nav), tuple(nav.target()),
-                            None if replanner.plan is None else replanner.plan.waypoints))
+        frames.append(snapshot(robot.true_pose()))
     if progress:
         progress(t, distance, len(nav.cues))
     settle_ms = [s.wall_s * 1000 for s in nav.settles[1:]] or [nav.settles[0].wall_s * 1000]
     return TrialResult(
         world=world.name, goal=goal, seed=seed, perception=mode, success=nav.succeeded, reason=reason,
         distance_m=distance, sim_s=t, wall_s=time.perf_counter() - began, start=start, cues=nav.cues,
-        trajectory=np.array(trajectory), final_positions=_places(nav),
-        fixed_tags={int(name[1:]): (f.x, f.y) for name, f in nav.model.fixed.items() if name[1:].isdigit()},
+        trajectory=np.array(trajectory), final_positions=dict(imagined_positions(nav.model)),
         exploration_bumps=bumps, settle_median_ms=float(np.median(settle_ms)), frames=frames,
-        grid_image=grid.to_image(), grid_extent=grid.extent,
+        grid_extent=grid.extent,
     )
 
 
@@ -255,7 +257,3 @@ def _perception_kwargs(mode: str, params: TrialParams) -> dict[str, Any]:
         return {"params": GeometricParams(noise_m=params.detection_noise_m,
                                           noise_rad=math.radians(params.detection_noise_deg))}
     return {}
-
-
-def _places(nav: Navigator) -> dict[str, tuple[float, float]]:
-    return {name: (float(xy[0]), float(xy[1])) for name, xy in nav.model.positions.items()}
