@@ -13,13 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-
-def _check_pose(pose: tuple[float, float, float] | np.ndarray, name: str = "pose") -> tuple[float, float, float]:
-    """``pose`` as three finite floats (x m, y m, theta rad); ValueError naming it otherwise."""
-    values = np.asarray(pose, dtype=float).ravel()
-    if values.shape != (3,) or not np.all(np.isfinite(values)):
-        raise ValueError(f"{name} must be three finite numbers (x m, y m, theta rad), got {pose!r}")
-    return float(values[0]), float(values[1]), float(values[2])
+from .pose import check_pose
 
 
 def wrap_angle(angle: float) -> float:
@@ -108,7 +102,7 @@ class PathFollower:
         the stop on arrival is not rate-limited (the approach is already slow).
         """
         p = self.params
-        x, y, theta = _check_pose(pose)
+        x, y, theta = check_pose(pose)
         pts = _check_waypoints(waypoints)
         position = np.array([x, y])
         to_goal = float(np.hypot(*(pts[-1] - position)))
@@ -192,7 +186,7 @@ class StuckDetector:
         """
         if not math.isfinite(t):
             raise ValueError(f"t must be finite, got {t}")
-        x, y, theta = _check_pose(pose)
+        x, y, theta = check_pose(pose)
         if self._history and t < self._history[-1][0]:
             raise ValueError(f"t went backwards: {t} after {self._history[-1][0]}")
         if not commanded:

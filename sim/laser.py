@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .pose import check_pose
+
 Cast = Callable[[np.ndarray, np.ndarray], np.ndarray]
 """``cast(origins (N, 2), ends (N, 2)) -> hit fractions (N,)`` in [0, 1]; 1.0 = no hit."""
 
@@ -39,14 +41,6 @@ class LaserParams:
             raise ValueError(f"LaserParams.n_beams must be >= 1, got {self.n_beams}")
         if not (math.isfinite(self.noise_std_m) and self.noise_std_m >= 0):
             raise ValueError(f"LaserParams.noise_std_m must be finite and >= 0, got {self.noise_std_m}")
-
-
-def check_pose(pose: tuple[float, float, float] | np.ndarray, name: str = "pose") -> tuple[float, float, float]:
-    """``pose`` as three finite floats (x m, y m, theta rad); ValueError naming it otherwise."""
-    values = np.asarray(pose, dtype=float).ravel()
-    if values.shape != (3,) or not np.all(np.isfinite(values)):
-        raise ValueError(f"{name} must be three finite numbers (x m, y m, theta rad), got {pose!r}")
-    return float(values[0]), float(values[1]), float(values[2])
 
 
 def laser_angles(params: LaserParams = LaserParams()) -> np.ndarray:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim.laser import check_pose
+from .pose import check_pose
 
 FREE_GREY = 254  # map_server colours for to_image()
 OCCUPIED_GREY = 0
