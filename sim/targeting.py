@@ -38,12 +38,17 @@ class Target:
     local: bool  # True when it stands in for a goal behind walls
 
 
-def seen_passable(grid: OccupancyGrid, robot_radius_m: float, fill_holes_cells: int) -> np.ndarray:
-    """Cells seen free (small unseen specks filled), at least the robot's radius from any seen obstacle."""
+def clearance_m(grid: OccupancyGrid) -> np.ndarray:
+    """Distance (m) from each cell to the nearest seen obstacle."""
+    return ndimage.distance_transform_edt(~grid.occupied_mask()) * grid.resolution
+
+
+def seen_passable(grid: OccupancyGrid, clearance: np.ndarray, robot_radius_m: float,
+                  fill_holes_cells: int) -> np.ndarray:
+    """Cells seen free (small unseen specks filled), more than the robot's radius (m) from any seen obstacle."""
     free = grid.free_mask()
     if fill_holes_cells > 0:
-        free = ndimage.binary_closing(free, iterations=fill_holes_cells) & ~grid.occupied_mask()
-    clearance = ndimage.distance_transform_edt(~grid.occupied_mask()) * grid.resolution
+        free = ndimage.binary_closing(free, iterations=fill_holes_cells) & (clearance > 0)
     return free & (clearance > robot_radius_m)
 
 
@@ -56,7 +61,8 @@ def nearest_seen_point(grid: OccupancyGrid, robot_xy: np.ndarray, goal_xy: np.nd
     nearest one, the one with the most room (clearance from seen obstacles, counted
     up to ``view_clearance_m``) is chosen; ties go to the nearer.
     """
-    passable = seen_passable(grid, robot_radius_m, fill_holes_cells)
+    clearance = clearance_m(grid)
+    passable = seen_passable(grid, clearance, robot_radius_m, fill_holes_cells)
     components, _ = ndimage.label(passable, structure=np.ones((3, 3), dtype=bool))
     rc = grid.world_to_cell(np.asarray(robot_xy, dtype=float))[0]
     if not grid.in_bounds(rc[None])[0]:
@@ -70,7 +76,6 @@ def nearest_seen_point(grid: OccupancyGrid, robot_xy: np.ndarray, goal_xy: np.nd
     xy = grid.cell_to_world(cells)
     distance = np.hypot(*(xy - np.asarray(goal_xy)).T)
     near = distance <= distance.min() + view_slack_m
-    clearance = ndimage.distance_transform_edt(~grid.occupied_mask()) * grid.resolution
     room = np.minimum(clearance[cells[near, 0], cells[near, 1]], view_clearance_m)
     order = np.lexsort((distance[near], -np.round(room, 2)))
     return xy[near][order[0]]
