@@ -17,6 +17,7 @@ import numpy as np
 from scipy import ndimage
 from skimage.graph import MCP_Geometric
 
+from .visibility import readable
 from .world_data import Floorplan, Tag, World
 
 
@@ -58,11 +59,9 @@ def readable_cells(plan: Floorplan, tag: Tag, params: OracleParams) -> np.ndarra
     c0, c1 = max(0, centre[1] - r), min(cols, centre[1] + r + 1)
     rr, cc = np.mgrid[r0:r1, c0:c1]
     xy = plan.pixel_to_world(np.stack([rr.ravel(), cc.ravel()], axis=1)).reshape(*rr.shape, 2)
-    d = xy - np.array([tag.x, tag.y])
-    dist = np.hypot(d[..., 0], d[..., 1])
+    ok = readable(xy[..., 0], xy[..., 1], tag.x, tag.y, tag.theta, max_range_m=params.read_range_m,
+                  cone_half_angle_deg=params.cone_half_angle_deg)
     normal = np.array([math.cos(tag.theta), math.sin(tag.theta)])
-    cos_cone = math.cos(math.radians(params.cone_half_angle_deg))
-    ok = (dist <= params.read_range_m) & (dist > 1e-6) & ((d @ normal) >= cos_cone * dist)
     cand = np.argwhere(ok)
     mask = np.zeros_like(occupied)
     if len(cand) == 0:

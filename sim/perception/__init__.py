@@ -11,9 +11,10 @@ from typing import Any, Protocol
 
 from sim.perception.camera import CameraParams, CameraPerception
 from sim.perception.geometric import GeometricParams, GeometricPerception
-from sim.perception.sighting import Sighting, readable
+from sim.perception.sighting import Sighting
 from sim.robot import Robot
 from sim.scene import Scene
+from sim.visibility import readable
 
 PERCEPTION_MODES: dict[str, type[CameraPerception] | type[GeometricPerception]] = {
     "camera": CameraPerception,

@@ -25,9 +25,10 @@ import cv2
 import numpy as np
 import pybullet as p
 
-from sim.perception.sighting import Sighting, readable
+from sim.perception.sighting import Sighting
 from sim.robot import Robot
 from sim.scene import Scene
+from sim.visibility import readable
 
 _REFINEMENT = MappingProxyType({
     "none": cv2.aruco.CORNER_REFINE_NONE,

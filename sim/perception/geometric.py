@@ -17,9 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim.perception.sighting import Sighting, readable
+from sim.perception.sighting import Sighting
 from sim.robot import Robot
 from sim.scene import Scene
+from sim.visibility import readable
 
 
 @dataclass(frozen=True)
