@@ -17,13 +17,13 @@ from typing import Any
 
 import numpy as np
 
-from abstract_map.model import imagined_positions
 from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
-from sim.navigation.follower import FollowerParams, PathFollower, Recovery, RecoveryParams, StuckDetector, StuckParams
-from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
+from sim.navigation.follower import FollowerParams
+from sim.navigation.navigator import CueEvent, NavigatorParams
 from sim.navigation.planner import PlannerParams
-from sim.navigation.replanner import Replanner, ReplanParams
-from sim.navigation.targeting import Target, TargetParams, choose_target
+from sim.navigation.policies import PolicyParams, make_policy
+from sim.navigation.replanner import ReplanParams
+from sim.navigation.targeting import TargetParams
 from sim.perception import GeometricParams, Sighting, make_perception
 from sim.perception.laser import LaserParams, laser_angles, scan
 from sim.world.data import World, load_world
@@ -138,7 +138,7 @@ class Trial:
     """
 
     def __init__(self, world: World | str, goal: str, *, seed: int = 0, perception: str = "camera",
-                 params: TrialParams | None = None, progress: Progress | None = None,
+                 navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
                  record: bool = False) -> None:
         self.began = time.perf_counter()
         self.world = load_world(world) if isinstance(world, str) else world
@@ -162,22 +162,23 @@ class Trial:
         x0, x1, y0, y1 = self.world.floorplan.extent
         self.grid = OccupancyGrid(OccupancyParams(resolution_m=params.occupancy_resolution_m, bounds=(x0, x1, y0, y1)))
         self.angles = laser_angles(params.laser)
-        self.nav = Navigator.start(self.world, goal, self.start, params=params.navigator)
-        self.replanner = Replanner(params.replan, params.planner)
-        self.follower = PathFollower(params.follower)
-        self.stuck, self.recovery = StuckDetector(StuckParams()), Recovery(RecoveryParams())
+        self.navigator = navigator
+        self.policy = make_policy(navigator, self.world, goal, self.start, PolicyParams(
+            params.navigator, params.planner, params.replan, params.follower, params.targeting,
+            params.target_recheck_s))
+        self.goal_tags = {tag.id for tag in self.world.tags.values()
+                          if tag.kind == "label" and tag.text.casefold() == goal.casefold()}
+        self.success = False
         self.steps_per_tick = max(1, round(1.0 / params.control_hz / scene.time_step))
         self.tick = self.steps_per_tick * scene.time_step  # s of simulated time per step
         self.every = {name: max(1, round(params.control_hz / hz)) for name, hz in
                       (("map", params.mapping_hz), ("see", params.perception_hz), ("traj", params.trajectory_hz))}
         self.frame_every = max(1, round(params.record_every_s / self.tick))
-        self.t, self.distance, self.n, self.bumps = 0.0, 0.0, 0, 0
+        self.t, self.distance, self.n = 0.0, 0.0, 0
         self.last = self.robot.true_pose()
         self.trajectory: list[tuple[float, float, float, float]] = [(0.0, *self.last)]
         self.frames: list[Frame] = []
         self.reason = ""
-        self.target: Target | None = None
-        self.target_at = -math.inf
         self.scan: np.ndarray | None = None  # m, the latest laser ranges
         self.sightings: list[Sighting] = []  # the tags read at the latest look
         self._sense()
@@ -208,10 +209,9 @@ class Trial:
             self.grid.integrate(pose, self.angles, self.scan, params.laser.max_range_m)
         if self.n % self.every["see"] == 0:
             self.sightings = self.sensor.observe(self.robot)
-            if self.nav.observe(self.sightings, t_s=self.t, distance_m=self.distance,
-                                explored_centre=self.grid.explored_centre):
-                self.target = None
-            if self.nav.succeeded:
+            self.policy.observe(self.sightings, t_s=self.t, distance_m=self.distance, grid=self.grid)
+            if any(s.tag_id in self.goal_tags for s in self.sightings):
+                self.success = True
                 self.reason = "goal label read"
                 return
         if self.t >= params.max_sim_s:
@@ -220,37 +220,10 @@ class Trial:
             self.reason = f"distance cap of {params.max_distance_m:.0f} m reached"
 
     def command(self) -> tuple[float, float]:
-        """The navigator's own (v, w) for this tick (m/s, rad/s); may end the trial (exploration exhausted)."""
-        params, t, pose = self.params, self.t, self.robot.pose()
-        # A stand-in target is kept until the model changes; the imagined goal is re-checked as the map grows.
-        if self.target is None or (not self.target.local and t - self.target_at >= params.target_recheck_s):
-            detours = self.nav.bumps_in_a_row >= params.targeting.local_bumps
-            robot_xy = np.array(pose[:2])
-            self.target = choose_target(self.grid, robot_xy, self.nav.target(robot_xy), params.planner,
-                                        params.targeting, allow_detours=detours)
-            self.target_at = t
-        v = w = 0.0
-        if self.recovery.active:
-            step = self.recovery.step(t)
-            v, w = step.v, step.w
-            if step.replan:
-                self.replanner.request()
-                self.stuck.reset()
-            return v, w
-        plan = self.replanner.update(t, self.grid, pose[:2], self.target.xy)
-        arrived = plan is None
-        if plan is not None:
-            v, w, done = self.follower.command(pose, plan.waypoints, self.tick)
-            arrived = done and float(np.hypot(*(np.array(plan.goal_xy) - pose[:2]))) < self.nav.params.arrive_m
-            if self.stuck.update(t, pose, commanded=abs(v) > 0.01 or abs(w) > 0.01):
-                self.recovery.start(t, turn_sign=1.0 if self.rng.random() < 0.5 else -1.0)
-        if arrived:
-            if not self.nav.arrived_without_goal(self.grid.explored_centre()):
-                self.reason = "exploration exhausted: the goal was not found where imagined"
-                return 0.0, 0.0
-            self.bumps += 1
-            self.target = None
-            self.replanner.request()
+        """The navigator's own (v, w) for this tick (m/s, rad/s); may end the trial (the navigator gave up)."""
+        v, w = self.policy.command(self.t, self.robot.pose(), self.grid, self.tick, self.rng)
+        if self.policy.gave_up:
+            self.reason = self.policy.gave_up
         return v, w
 
     def step(self, command: tuple[float, float] | None = None) -> bool:
@@ -270,7 +243,7 @@ class Trial:
         if self.n % self.every["traj"] == 0:
             self.trajectory.append((self.t, *now))
         if self.progress and self.n % round(1.0 / self.tick) == 0:
-            self.progress(self.t, self.distance, len(self.nav.cues))
+            self.progress(self.t, self.distance, len(self.policy.cues))
         if self.record and self.n % self.frame_every == 0:
             self.frames.append(self.snapshot(now))
         self._sense()
@@ -280,9 +253,8 @@ class Trial:
 
     def snapshot(self, pose: tuple[float, float, float]) -> Frame:
         """An animation frame of the trial now."""
-        shown = self.nav.target() if self.target is None else self.target.xy
-        return Frame(self.t, pose, self.grid.to_image(), dict(imagined_positions(self.nav.model)), tuple(shown),
-                     None if self.replanner.plan is None else self.replanner.plan.waypoints)
+        places, target, path = self.policy.picture()
+        return Frame(self.t, pose, self.grid.to_image(), places, target, path)
 
     def result(self) -> TrialResult:
         """What the trial did so far, as written to result.json."""
@@ -290,24 +262,24 @@ class Trial:
         trajectory = [*self.trajectory, (self.t, *final)]
         frames = [*self.frames, self.snapshot(final)] if self.record else []
         if self.progress:
-            self.progress(self.t, self.distance, len(self.nav.cues))
-        nav = self.nav
-        settle_ms = [s.wall_s * 1000 for s in nav.settles[1:]] or [nav.settles[0].wall_s * 1000]
+            self.progress(self.t, self.distance, len(self.policy.cues))
+        settle_ms = self.policy.settle_ms()
         return TrialResult(
-            world=self.world.name, goal=self.goal, seed=self.seed, perception=self.mode, success=nav.succeeded,
+            world=self.world.name, goal=self.goal, seed=self.seed, perception=self.mode, success=self.success,
             reason=self.reason, distance_m=self.distance, sim_s=self.t, wall_s=time.perf_counter() - self.began,
-            start=self.start, cues=nav.cues, trajectory=np.array(trajectory),
-            final_positions=dict(imagined_positions(nav.model)), exploration_bumps=self.bumps,
-            settle_median_ms=float(np.median(settle_ms)), frames=frames, grid_extent=self.grid.extent,
+            start=self.start, cues=self.policy.cues, trajectory=np.array(trajectory),
+            final_positions=self.policy.picture()[0], exploration_bumps=getattr(self.policy, "bumps", 0),
+            settle_median_ms=float(np.median(settle_ms)) if settle_ms else 0.0, frames=frames,
+            grid_extent=self.grid.extent,
         )
 
 
 def run_trial(world: World | str, goal: str, *, seed: int = 0, perception: str = "camera",
-              params: TrialParams | None = None, progress: Progress | None = None,
+              navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
               record: bool = False) -> TrialResult:
     """Run one trial of finding ``goal`` in ``world`` with the navigator driving, and report what happened."""
-    with Trial(world, goal, seed=seed, perception=perception, params=params, progress=progress,
-               record=record) as trial:
+    with Trial(world, goal, seed=seed, perception=perception, navigator=navigator, params=params,
+               progress=progress, record=record) as trial:
         while not trial.done:
             trial.step()
         return trial.result()
