@@ -23,6 +23,8 @@ from .hierarchy import HierarchyError
 from .model import UnknownPlaceError
 from .scenario import ScenarioError, load_scenario, replay
 
+SUMMARY = "replay a scenario of cues and write the imagined map after each"
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scenario", type=Path, help="scenario JSON (hierarchy, start, optional goal, steps)")
