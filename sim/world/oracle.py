@@ -40,13 +40,18 @@ class OraclePath:
 
 
 def pooled_floorplan(world: World, cell_m: float) -> Floorplan:
-    """The floor plan max-pooled to cells of about ``cell_m`` (m); the origin is unchanged."""
-    factor = max(1, round(cell_m / world.floorplan.resolution))
-    occ = world.floorplan.occupied
+    """The world's floor plan max-pooled to cells of about ``cell_m`` (m); the origin is unchanged."""
+    return pool_plan(world.floorplan, cell_m)
+
+
+def pool_plan(plan: Floorplan, cell_m: float) -> Floorplan:
+    """``plan`` max-pooled to cells of about ``cell_m`` (m); the origin is unchanged."""
+    factor = max(1, round(cell_m / plan.resolution))
+    occ = plan.occupied
     rows, cols = (occ.shape[0] // factor) * factor, (occ.shape[1] // factor) * factor
     occ = occ[occ.shape[0] - rows:, :cols]  # crop from the top, keeping the bottom-left origin
     pooled = occ.reshape(rows // factor, factor, cols // factor, factor).any(axis=(1, 3))
-    return Floorplan(pooled, world.floorplan.resolution * factor, world.floorplan.origin)
+    return Floorplan(pooled, plan.resolution * factor, plan.origin)
 
 
 def readable_cells(plan: Floorplan, tag: Tag, params: OracleParams) -> np.ndarray:
