@@ -20,7 +20,7 @@ class Style:
     rooms: tuple[str, ...]  # kinds of room; a room is "<area> <kind>", numbered when repeated
     halls: tuple[str, ...]  # names of open halls
     corridor_m: tuple[float, float] = (1.8, 2.4)  # m, clear corridor width (building codes: 1.8 m for two wheelchairs)
-    room_m2: float = 22.0  # m^2, mean room floor area before walls (a two-person office)
+    room_m2: float = 40.0  # m^2, mean room floor area (a room here is a suite: an office of four, a ward)
     min_room_side_m: float = 2.6  # m, narrowest room (a 1 m door and a label beside it need ~2.4 m of wall)
     cut_fraction: float = 0.35  # share of optional corridor segments removed (fewer: more loops)
     halls_per_building: int = 1  # blocks turned into open halls
@@ -36,7 +36,7 @@ STYLES: dict[str, Style] = {
         rooms=("Office", "Meeting Room", "Kitchen", "Print Room", "Storeroom", "Studio", "Lab", "Library"),
         halls=("Atrium", "Lobby"),
         corridor_m=(1.8, 2.4),
-        room_m2=20.0,
+        room_m2=40.0,
         cut_fraction=0.35,
     ),
     "hospital": Style(
@@ -48,7 +48,7 @@ STYLES: dict[str, Style] = {
                "Recovery", "Records"),
         halls=("Main Foyer", "Waiting Hall"),
         corridor_m=(2.4, 3.0),  # beds pass each other
-        room_m2=26.0,
+        room_m2=45.0,
         cut_fraction=0.3,
     ),
     "museum": Style(
@@ -59,7 +59,7 @@ STYLES: dict[str, Style] = {
         rooms=("Room", "Vault", "Cabinet", "Annex", "Alcove", "Study"),
         halls=("Great Hall", "Sculpture Court"),
         corridor_m=(2.2, 3.0),
-        room_m2=34.0,  # galleries are larger than offices
+        room_m2=55.0,  # galleries are larger than offices
         cut_fraction=0.45,
         halls_per_building=2,
         through_rooms=2,  # galleries open into each other
@@ -72,7 +72,7 @@ STYLES: dict[str, Style] = {
         rooms=("Lecture Theatre", "Tutorial Room", "Laboratory", "Staff Room", "Seminar Room", "Computer Lab"),
         halls=("Student Hub", "Refectory"),
         corridor_m=(2.0, 3.0),
-        room_m2=30.0,
+        room_m2=48.0,
         cut_fraction=0.4,
     ),
 }
@@ -90,7 +90,7 @@ class Size:
 
 SIZES: dict[str, Size] = {
     # about 30 m across, 8-16 rooms: a small clinic or one floor of a house of offices
-    "small": Size(cells=(3, 2), cell_m=(9.0, 11.0), levels=3, wings=1),
+    "small": Size(cells=(3, 3), cell_m=(8.0, 10.0), levels=3, wings=1),
     # 40-60 m across, 15-40 rooms, like one real floor
     "medium": Size(cells=(3, 3), cell_m=(13.0, 17.0), levels=4, wings=2),
     # 60-90 m across
