@@ -4,11 +4,11 @@ Shared by the generator (it writes only what these call true) and the world
 check (it reports what they call false). Positions come from what a world
 folder holds:
 
-- a place with no children (a room) lies ``behind_m`` behind the face of its
-  label (the mean over its labels, when it has several); a leaf with no label
-  has no position;
-- a place with children (an area, a wing, the building) lies at the mean of
-  its children's positions;
+- a place with a label lies ``behind_m`` behind the label's face (the mean
+  over its labels, when it has several): a label is the direct evidence of
+  where a place is (rooms; areas labelled at their entrance, as in the zoo);
+- a place with no label lies at the mean of its children's positions (areas,
+  wings, the building); one with neither has no position;
 - a sign's context ("here", or no ``from ...``) is the sign's tag position.
 
 Tests (``tolerance_deg`` 45 by default; F the figure, R a referent, C the context):
@@ -113,11 +113,11 @@ def place_positions(hierarchy: Hierarchy, tags: Mapping[int, Tag], behind_m: flo
     def visit(name: str) -> np.ndarray | None:
         if name in positions:
             return positions[name]
-        if name in kids:
-            found = [p for p in (visit(c) for c in kids[name]) if p is not None]
-            pos = np.mean(found, axis=0) if found else None
+        if name in labels:
+            pos = np.mean(labels[name], axis=0)
         else:
-            pos = np.mean(labels[name], axis=0) if name in labels else None
+            found = [p for p in (visit(c) for c in kids.get(name, [])) if p is not None]
+            pos = np.mean(found, axis=0) if found else None
         if pos is not None:
             positions[name] = pos
         return pos
