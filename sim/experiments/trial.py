@@ -91,6 +91,7 @@ class TrialResult:
     settle_median_ms: float
     frames: list[Frame] = field(default_factory=list, repr=False)
     grid_extent: tuple[float, float, float, float] | None = None
+    navigator: str = "paper"  # the navigation policy's name (sim.navigation.policies.NAVIGATORS)
 
     @property
     def realtime_factor(self) -> float:
@@ -100,6 +101,7 @@ class TrialResult:
     def to_dict(self) -> dict[str, Any]:
         return {
             "world": self.world, "goal": self.goal, "seed": self.seed, "perception": self.perception,
+            "navigator": self.navigator,
             "success": self.success, "reason": self.reason, "distance_m": round(self.distance_m, 3),
             "sim_s": round(self.sim_s, 2), "wall_s": round(self.wall_s, 2),
             "realtime_factor": round(self.realtime_factor, 2), "start": list(self.start),
@@ -270,7 +272,7 @@ class Trial:
             start=self.start, cues=self.policy.cues, trajectory=np.array(trajectory),
             final_positions=self.policy.picture()[0], exploration_bumps=getattr(self.policy, "bumps", 0),
             settle_median_ms=float(np.median(settle_ms)) if settle_ms else 0.0, frames=frames,
-            grid_extent=self.grid.extent,
+            grid_extent=self.grid.extent, navigator=self.navigator,
         )
 
 

@@ -3,6 +3,7 @@
 Example:
   abstract-map trial --world zoo --goal Lion --out runs/lion
   abstract-map trial --world zoo --goal Toilets --perception geometric --seed 3 --out runs/t3 --record
+  abstract-map trial --world zoo --goal Lion --navigator frontier --perception geometric --out runs/f
 
 Prints a live progress line (simulated time, distance, cues read), then writes
 DIR/result.json (goal, success, reason, distance_m, simulated and wall seconds,
@@ -32,6 +33,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     parser.add_argument("--perception", default="camera", choices=["camera", "geometric"],
                         help="rendered camera + OpenCV AprilTag detector, or the fast geometric check")
+    parser.add_argument("--navigator", default="paper",
+                        help="navigation policy: paper (the paper's robot, reads signs; default) or frontier "
+                             "(nearest frontier, reads no sign: the no-signs lower bound)")
     parser.add_argument("--out", type=Path, required=True, help="output folder")
     parser.add_argument("--record", action="store_true", help="also write DIR/run.gif, an animation of the run")
     parser.add_argument("--max-sim-s", type=float, default=None, help="cap on simulated seconds (default 900)")
@@ -42,12 +46,15 @@ def run(args: argparse.Namespace) -> int:
 
     from sim.experiments.pictures import animation, trajectory_picture
     from sim.experiments.trial import TrialParams, run_trial
+    from sim.navigation.policies import NAVIGATORS
     from sim.world.data import WorldError, load_world
 
     try:
         world = load_world(args.world)
     except WorldError as exc:
         raise ExitError(str(exc)) from exc
+    if args.navigator not in NAVIGATORS:
+        raise ExitError(f"--navigator {args.navigator!r}: expected one of {', '.join(NAVIGATORS)}")
     params = TrialParams()
     if args.max_sim_s is not None:
         params = replace(params, max_sim_s=args.max_sim_s)
@@ -61,7 +68,8 @@ def run(args: argparse.Namespace) -> int:
             print(line, file=sys.stderr, flush=True)
 
     try:
-        result = run_trial(world, args.goal, seed=args.seed, perception=args.perception, params=params,
+        result = run_trial(world, args.goal, seed=args.seed, perception=args.perception,
+                           navigator=args.navigator, params=params,
                            progress=progress, record=args.record)
     except ValueError as exc:
         raise ExitError(str(exc)) from exc

@@ -56,6 +56,7 @@ class OccupancyGrid:
         cols = int(math.ceil((x_max - x_min) / res - 1e-9))
         rows = int(math.ceil((y_max - y_min) / res - 1e-9))
         self.log_odds = np.zeros((rows, cols), dtype=np.float32)
+        self.version = 0  # counts the scans integrated, so users can tell when the map changed
 
     @property
     def resolution(self) -> float:
@@ -147,23 +148,30 @@ class OccupancyGrid:
         before_end = np.where(hit[:, None], d[None, :] < reach[:, None], d[None, :] <= reach[:, None])
         px = x + direction[:, 0:1] * d[None, :]
         py = y + direction[:, 1:2] * d[None, :]
-        free_cells = self._flat_indices(px[before_end], py[before_end])
+        free_rc = self._cells_inside(px[before_end], py[before_end])
         # Nudge hit points slightly along the beam so a hit on a cell face lands in the far cell.
         end = np.array([x, y]) + direction[hit] * (reach[hit] + 0.05 * self.resolution)[:, None]
-        hit_cells = self._flat_indices(end[:, 0], end[:, 1])
-
-        hit_cells = np.unique(hit_cells)
-        free_cells = np.setdiff1d(np.unique(free_cells), hit_cells, assume_unique=True)
-        flat = self.log_odds.reshape(-1)
+        hit_rc = self._cells_inside(end[:, 0], end[:, 1])
+        if len(free_rc) + len(hit_rc) == 0:
+            return
+        # Mark the cells in a window around the scan (one update per cell; hit wins over free), then update.
+        both = np.concatenate([free_rc, hit_rc])
+        r0, c0 = both.min(axis=0)
+        r1, c1 = both.max(axis=0) + 1
+        mark = np.zeros((r1 - r0, c1 - c0), dtype=np.int8)
+        mark[free_rc[:, 0] - r0, free_rc[:, 1] - c0] = 1
+        mark[hit_rc[:, 0] - r0, hit_rc[:, 1] - c0] = 2
+        window = self.log_odds[r0:r1, c0:c1]
         lo, hi = self.params.clamp
-        flat[free_cells] = np.maximum(flat[free_cells] + self.params.l_free, lo)
-        flat[hit_cells] = np.minimum(flat[hit_cells] + self.params.l_occ, hi)
+        free, occupied = mark == 1, mark == 2
+        window[free] = np.maximum(window[free] + self.params.l_free, lo)
+        window[occupied] = np.minimum(window[occupied] + self.params.l_occ, hi)
+        self.version += 1
 
-    def _flat_indices(self, px: np.ndarray, py: np.ndarray) -> np.ndarray:
-        """Flat indices of the in-bounds cells holding world points (px, py)."""
+    def _cells_inside(self, px: np.ndarray, py: np.ndarray) -> np.ndarray:
+        """(row, col) (N, 2) of the in-bounds cells holding world points (px, py)."""
         rc = self.world_to_cell(np.stack([px, py], axis=1))
-        rc = rc[self.in_bounds(rc)]
-        return rc[:, 0] * self.shape[1] + rc[:, 1]
+        return rc[self.in_bounds(rc)]
 
     def occupied_mask(self) -> np.ndarray:
         """Bool (rows, cols): cells believed occupied."""
@@ -197,4 +205,5 @@ class OccupancyGrid:
         other = OccupancyGrid.__new__(OccupancyGrid)
         other.params = self.params
         other.log_odds = self.log_odds.copy()
+        other.version = self.version
         return other

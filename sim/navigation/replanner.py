@@ -60,13 +60,12 @@ def _densify(points: np.ndarray, step: float) -> np.ndarray:
     """Points every ``step`` m along a polyline, vertices included, in order."""
     if len(points) == 1:
         return points.copy()
-    parts = []
-    for a, b in zip(points[:-1], points[1:]):
-        n = max(1, int(math.ceil(float(np.hypot(*(b - a))) / step)))
-        s = np.linspace(0.0, 1.0, n, endpoint=False)[:, None]
-        parts.append(a[None, :] + s * (b - a)[None, :])
-    parts.append(points[-1:])
-    return np.concatenate(parts)
+    segments = np.diff(points, axis=0)
+    counts = np.maximum(1, np.ceil(np.hypot(*segments.T) / step).astype(int))
+    owner = np.repeat(np.arange(len(segments)), counts)
+    index = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    fraction = index / counts[owner]
+    return np.concatenate([points[:-1][owner] + fraction[:, None] * segments[owner], points[-1:]])
 
 
 @dataclass(frozen=True)

@@ -58,7 +58,9 @@ _HIDDEN = (1.0, 1.0, 1.0, 0.0)
 class SceneParams:
     """How the simulated building is built and stepped."""
 
-    time_step_s: float = 1.0 / 60.0  # s, physics step
+    # s, physics step: three per 0.1 s control tick. A scripted 24 s drive ends within 5 cm and 0.1 rad of
+    # where it ends at 1/60 s, at half the cost (physics was a third of a geometric trial's wall time).
+    time_step_s: float = 1.0 / 30.0
     gravity_mps2: float = -9.81  # m/s^2, along world z
     wall_cell_m: float = 0.06  # m, target cell of the pooled occupancy grid
     wall_simplify_cells: float = 0.35  # cells, polyline simplification tolerance
@@ -329,9 +331,11 @@ class Scene:
             hits = p.rayTestBatch(origins[start:start + _MAX_RAY_BATCH].tolist(),
                                   ends[start:start + _MAX_RAY_BATCH].tolist(),
                                   collisionFilterMask=WALL_GROUP, physicsClientId=self.client)
-            for i, hit in enumerate(hits, start):
-                if hit[0] >= 0:
-                    bodies[i], fractions[i] = hit[0], hit[2]
+            ids = np.fromiter((hit[0] for hit in hits), dtype=int, count=len(hits))
+            along = np.fromiter((hit[2] for hit in hits), dtype=float, count=len(hits))
+            hit = ids >= 0
+            bodies[start:start + len(hits)][hit] = ids[hit]
+            fractions[start:start + len(hits)][hit] = along[hit]
         return fractions, bodies
 
     def ray_fractions(self, origins: np.ndarray, ends: np.ndarray) -> np.ndarray:
