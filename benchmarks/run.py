@@ -146,7 +146,7 @@ def generalise_tables(records: list[dict], title: str) -> None:
     from sim.experiments.summary import stats
 
     header = ["perception", "navigator", "{}", "trials", "success", "SPL", "ratio to oracle", "wall per trial (s)",
-              "wall in all (min)"]
+              "CPU per trial (s)", "wall in all (min)"]
     for column in ("signage", "style"):
         groups: dict[tuple[str, str, str], list[dict]] = {}
         for record in records:
@@ -159,17 +159,35 @@ def generalise_tables(records: list[dict], title: str) -> None:
             s = stats(mine)
             rows.append([perception, navigator, value, str(s["trials"]), f"{100 * s['success']:.0f}%",
                          f"{s['spl']:.2f}", "-" if math.isnan(s["ratio"]) else f"{s['ratio']:.2f}",
-                         f"{s['wall']:.1f}", f"{sum(r.get('wall_s') or 0 for r in mine) / 60:.1f}"])
+                         f"{s['wall']:.1f}", "-" if math.isnan(s["cpu"]) else f"{s['cpu']:.1f}",
+                         f"{sum(r.get('wall_s') or 0 for r in mine) / 60:.1f}"])
         table(f"{title}, per navigator and {column}", [h.format(column) for h in header], rows)
 
 
+def finished_trials(out: Path) -> list[dict]:
+    """Every trial record already written under ``out`` (both parts), for a report of what has run so far."""
+    import json
+
+    records = []
+    for path in sorted(out.glob("*/trials/*/*.json")):
+        try:
+            records.append(json.loads(path.read_text()))
+        except (OSError, ValueError):
+            continue  # a file being written: counted next time
+    return records
+
+
 def bench_generalise(buildings: int = 50, camera_buildings: int = 10, workers: int = 2,
-                     out: Path = ROOT / "runs" / "generalise") -> None:
+                     out: Path = ROOT / "runs" / "generalise", report_only: bool = False) -> None:
     from tqdm import tqdm
 
     from sim.experiments.study import StudySettings
     from sim.experiments.study_run import conduct_study
 
+    if report_only:
+        records = finished_trials(out)
+        generalise_tables(records, f"Generalisation, the {len(records)} trials finished so far in {out}")
+        return
     began = time.perf_counter()
     parts = [("geometric", buildings, ("paper", "frontier")), ("camera", camera_buildings, ("paper",))]
     records: list[dict] = []
@@ -211,6 +229,8 @@ def main() -> int:
     parser.add_argument("--workers", type=int, default=2, help="generalise: parallel trials (default 2)")
     parser.add_argument("--out", type=Path, default=ROOT / "runs" / "generalise",
                         help="generalise: study folder, re-used to resume (default runs/generalise)")
+    parser.add_argument("--report-only", action="store_true",
+                        help="generalise: tabulate the trials finished so far in --out; run nothing")
     args = parser.parse_args()
     unknown = [w for w in args.which if w not in BENCHMARKS and w not in NAMED_ONLY]
     if unknown:
@@ -219,7 +239,7 @@ def main() -> int:
         parser.error("--buildings must be 1-1000, --camera-buildings 0 to --buildings, --workers at least 1")
     for name in args.which or BENCHMARKS:
         if name == "generalise":
-            bench_generalise(args.buildings, args.camera_buildings, args.workers, args.out)
+            bench_generalise(args.buildings, args.camera_buildings, args.workers, args.out, args.report_only)
         else:
             BENCHMARKS[name]()
     return 0

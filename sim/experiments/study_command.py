@@ -16,7 +16,7 @@ DIR/worlds/. Seeds 0-999 are for development; 1000-1999 are test buildings, for 
 Trials differ by seed: start-pose jitter (0.10 m, 3 deg), the recovery's turning direction and, in
 geometric mode, detection noise (0.03 m, 1 deg). Writes DIR/settings.json, DIR/trials/ (one JSON per
 trial), DIR/trials.csv (world, style, signage, navigator, goal, seed, perception, success, reason,
-distance_m, oracle_m, spl, sim_s, wall_s), DIR/report.md (success rate, SPL, ratio to the oracle and
+distance_m, oracle_m, spl, sim_s, wall_s, cpu_s), DIR/report.md (success rate, SPL, ratio to the oracle and
 failures by reason: overall, per navigator, style, signage level and world; the ten worst trials with
 pictures in DIR/worst/) and, for the zoo, the paper's Table I extended, DIR/comparison.png (box plots
 like the paper's Fig. 11) and DIR/paths/GOAL.png. Run again on the same DIR to resume (across worlds):
@@ -70,9 +70,12 @@ def run(args: argparse.Namespace) -> int:
     settings = StudySettings(worlds=tuple(args.world or ["zoo"]), perception=args.perception,
                              navigators=navigator_list(args.navigator), trials=args.trials,
                              goals=tuple(args.goals) if args.goals else None)
-    bar = tqdm(total=0, unit="trial", file=sys.stderr, dynamic_ncols=True)
+    bars: list[Any] = []  # made at the first progress call, so a bad argument prints its one line alone
 
     def progress(done: int, total: int, record: dict[str, Any] | None) -> None:
+        if not bars:
+            bars.append(tqdm(total=total, unit="trial", file=sys.stderr, dynamic_ncols=True))
+        bar = bars[0]
         bar.total, bar.n = total, done
         if record is not None:
             verdict = f"{record['distance_m']:.1f} m" if record["success"] else "FAILED"
@@ -86,7 +89,8 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:  # StudyError, WorldSpecError, WorldError: bad input, one line
         raise ExitError(str(exc)) from exc
     finally:
-        bar.close()
+        for bar in bars:
+            bar.close()
     print(outcome.report, file=sys.stderr)
     records = outcome.records
     failed = sum(1 for r in records if not r["success"])

@@ -40,11 +40,13 @@ def stats(records: list[Record]) -> dict[str, Any]:
     ratios = [r["oracle_ratio"] for r in found if r.get("oracle_ratio") is not None]
     distances = [r["distance_m"] for r in found if r.get("distance_m") is not None]
     walls = [r["wall_s"] for r in records if r.get("wall_s") is not None]
+    cpus = [r["cpu_s"] for r in records if r.get("cpu_s") is not None and math.isfinite(r["cpu_s"])]
     return {"trials": n, "found": len(found), "success": len(found) / n if n else math.nan,
             "spl": float(np.mean(spls)) if spls else math.nan,
             "ratio": float(np.mean(ratios)) if ratios else math.nan,
             "distance": float(np.mean(distances)) if distances else math.nan,
             "wall": float(np.mean(walls)) if walls else math.nan,
+            "cpu": float(np.mean(cpus)) if cpus else math.nan,
             "failures": Counter(reason_kind(r) for r in records if not r["success"])}
 
 

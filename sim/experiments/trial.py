@@ -92,6 +92,7 @@ class TrialResult:
     frames: list[Frame] = field(default_factory=list, repr=False)
     grid_extent: tuple[float, float, float, float] | None = None
     navigator: str = "paper"  # the navigation policy's name (sim.navigation.policies.NAVIGATORS)
+    cpu_s: float = math.nan  # s of this process's CPU time: unlike wall time, not stretched by a busy machine
 
     @property
     def realtime_factor(self) -> float:
@@ -103,7 +104,7 @@ class TrialResult:
             "world": self.world, "goal": self.goal, "seed": self.seed, "perception": self.perception,
             "navigator": self.navigator,
             "success": self.success, "reason": self.reason, "distance_m": round(self.distance_m, 3),
-            "sim_s": round(self.sim_s, 2), "wall_s": round(self.wall_s, 2),
+            "sim_s": round(self.sim_s, 2), "wall_s": round(self.wall_s, 2), "cpu_s": round(self.cpu_s, 2),
             "realtime_factor": round(self.realtime_factor, 2), "start": list(self.start),
             "cues": [asdict(c) for c in self.cues],
             "exploration_bumps": self.exploration_bumps, "settle_median_ms": round(self.settle_median_ms, 2),
@@ -143,6 +144,7 @@ class Trial:
                  navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
                  record: bool = False) -> None:
         self.began = time.perf_counter()
+        self.began_cpu = time.process_time()
         self.world = load_world(world) if isinstance(world, str) else world
         self.params = params = params or TrialParams()
         if goal not in self.world.goals and not self.world.label_tags(goal):
@@ -272,7 +274,7 @@ class Trial:
             start=self.start, cues=self.policy.cues, trajectory=np.array(trajectory),
             final_positions=self.policy.picture()[0], exploration_bumps=getattr(self.policy, "bumps", 0),
             settle_median_ms=float(np.median(settle_ms)) if settle_ms else 0.0, frames=frames,
-            grid_extent=self.grid.extent, navigator=self.navigator,
+            grid_extent=self.grid.extent, navigator=self.navigator, cpu_s=time.process_time() - self.began_cpu,
         )
 
 
