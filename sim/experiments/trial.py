@@ -24,11 +24,11 @@ from sim.navigation.planner import PlannerParams
 from sim.navigation.policies import PolicyParams, make_policy
 from sim.navigation.replanner import ReplanParams
 from sim.navigation.targeting import TargetParams
-from sim.perception import GeometricParams, Sighting, make_perception
+from sim.perception import PERCEPTION_MODES, GeometricParams, Sighting, make_perception
 from sim.perception.laser import LaserParams, laser_angles, scan
 from sim.world.data import World, load_world
 from sim.world.robot import Robot, RobotParams
-from sim.world.scene import build_scene
+from sim.world.scene import SceneParams, build_scene
 
 
 @dataclass(frozen=True)
@@ -155,7 +155,8 @@ class Trial:
         self.observers: list[Observer] = []
         self.rng = rng = np.random.default_rng(seed)
         self.start = _start_pose(self.world, params, rng)
-        self.scene = scene = build_scene(self.world)
+        renders = getattr(PERCEPTION_MODES.get(perception), "renders", True)  # skip the looks when nothing renders
+        self.scene = scene = build_scene(self.world, params=SceneParams(visuals=renders))
         try:
             self.robot = Robot(scene, params=RobotParams(odometry_noise_m=params.odometry_noise_m), rng=rng)
             self.robot.reset(*self.start)

@@ -38,6 +38,8 @@ class GeometricParams:
 class GeometricPerception:
     """Reads tags by geometry: true tag poses (plus optional noise) from the world."""
 
+    renders = False  # needs no looks: the scene may be built without them (SceneParams.visuals=False)
+
     def __init__(self, scene: Scene, params: GeometricParams | None = None, *,
                  rng: np.random.Generator | None = None) -> None:
         self.scene = scene
