@@ -14,7 +14,7 @@ beams) are dropped. Distances are path lengths through passable seen space
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy import ndimage
@@ -62,16 +62,14 @@ def look(grid: OccupancyGrid, covered: np.ndarray, robot_xy: np.ndarray, params:
     y = robot_xy[1] + np.sin(angles)[:, None] * d[None, :]
     rc = grid.world_to_cell(np.stack([x.ravel(), y.ravel()], axis=1))
     inside = grid.in_bounds(rc)
-    occupied = np.zeros(len(rc), dtype=bool)
-    occupied[inside] = grid.occupied_mask()[rc[inside, 0], rc[inside, 1]]
-    occupied = occupied.reshape(x.shape)
+    values = np.zeros(len(rc), dtype=np.float32)  # outside the grid: unknown
+    values[inside] = grid.log_odds[rc[inside, 0], rc[inside, 1]]
+    occupied = (values > grid.params.occupied_threshold).reshape(x.shape)
+    known = (values > grid.params.occupied_threshold) | (values < grid.params.free_threshold)
     # visible: no occupied sample before this one along the ray (the first occupied one is visible)
     blocked_before = np.cumsum(occupied, axis=1) - occupied > 0
-    visible = (~blocked_before).ravel() & inside
-    known = ~grid.unknown_mask()
-    cells = rc[visible]
-    cells = cells[known[cells[:, 0], cells[:, 1]]]
-    covered[cells[:, 0], cells[:, 1]] = True
+    mark = (~blocked_before).ravel() & inside & known
+    covered[rc[mark, 0], rc[mark, 1]] = True
 
 
 def frontier_mask(grid: OccupancyGrid, robot_radius_m: float, params: FrontierParams,
@@ -145,10 +143,34 @@ def nearest_frontier(grid: OccupancyGrid, robot_xy: np.ndarray, robot_radius_m: 
 
 
 def still_frontier(grid: OccupancyGrid, target_xy: np.ndarray, robot_radius_m: float, params: FrontierParams,
-                   covered: np.ndarray | None = None) -> bool:
-    """Whether a frontier cell lies within ``reach_m`` plus one cell of ``target_xy`` (m)."""
-    frontier, _ = frontier_mask(grid, robot_radius_m, params, covered)
+                   covered: np.ndarray | None = None, margin_m: float = 2.0) -> bool:
+    """Whether a frontier cell lies within ``reach_m`` plus one cell of ``target_xy`` (m).
+
+    Judged on a window of the grid ``margin_m`` around the target (clearances and frontier groups
+    farther away do not change the answer there), so it costs little on a large map.
+    """
     rc = grid.world_to_cell(np.asarray(target_xy, dtype=float))[0]
+    pad = int(np.ceil(margin_m / grid.resolution))
+    rows, cols = grid.shape
+    r0, r1 = max(0, rc[0] - pad), min(rows, rc[0] + pad + 1)
+    c0, c1 = max(0, rc[1] - pad), min(cols, rc[1] + pad + 1)
+    if r0 >= r1 or c0 >= c1:
+        return False
+    window = _window(grid, r0, r1, c0, c1)
+    frontier, _ = frontier_mask(window, robot_radius_m, params, None if covered is None else covered[r0:r1, c0:c1])
     reach = int(np.ceil(params.reach_m / grid.resolution)) + 1
-    window = frontier[max(0, rc[0] - reach):rc[0] + reach + 1, max(0, rc[1] - reach):rc[1] + reach + 1]
-    return bool(window.any())
+    local = rc - [r0, c0]
+    near = frontier[max(0, local[0] - reach):local[0] + reach + 1, max(0, local[1] - reach):local[1] + reach + 1]
+    return bool(near.any())
+
+
+def _window(grid: OccupancyGrid, r0: int, r1: int, c0: int, c1: int) -> OccupancyGrid:
+    """The cells [r0:r1, c0:c1] of ``grid`` as a grid of their own (same cells, same world positions)."""
+    x0, y0 = grid.origin
+    res = grid.resolution
+    bounds = (x0 + c0 * res, x0 + c1 * res, y0 + (grid.shape[0] - r1) * res, y0 + (grid.shape[0] - r0) * res)
+    window = OccupancyGrid.__new__(OccupancyGrid)
+    window.params = replace(grid.params, bounds=bounds)
+    window.log_odds = grid.log_odds[r0:r1, c0:c1]
+    window.version = grid.version
+    return window
