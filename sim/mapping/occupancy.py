@@ -56,7 +56,7 @@ class OccupancyGrid:
         cols = int(math.ceil((x_max - x_min) / res - 1e-9))
         rows = int(math.ceil((y_max - y_min) / res - 1e-9))
         self.log_odds = np.zeros((rows, cols), dtype=np.float32)
-        self.version = 0  # counts the scans integrated, so users can tell when the map changed
+        self.version = 0  # counts changes (scans integrated); code editing log_odds directly bumps it too
 
     @property
     def resolution(self) -> float:
@@ -148,19 +148,19 @@ class OccupancyGrid:
         before_end = np.where(hit[:, None], d[None, :] < reach[:, None], d[None, :] <= reach[:, None])
         px = x + direction[:, 0:1] * d[None, :]
         py = y + direction[:, 1:2] * d[None, :]
-        free_rc = self._cells_inside(px[before_end], py[before_end])
+        free_r, free_c = self._cells_where(px, py, before_end)
         # Nudge hit points slightly along the beam so a hit on a cell face lands in the far cell.
         end = np.array([x, y]) + direction[hit] * (reach[hit] + 0.05 * self.resolution)[:, None]
-        hit_rc = self._cells_inside(end[:, 0], end[:, 1])
-        if len(free_rc) + len(hit_rc) == 0:
+        hit_r, hit_c = self._cells_where(end[:, 0], end[:, 1], np.ones(len(end), dtype=bool))
+        if free_r.size + hit_r.size == 0:
             return
         # Mark the cells in a window around the scan (one update per cell; hit wins over free), then update.
-        both = np.concatenate([free_rc, hit_rc])
-        r0, c0 = both.min(axis=0)
-        r1, c1 = both.max(axis=0) + 1
+        all_r, all_c = np.concatenate([free_r, hit_r]), np.concatenate([free_c, hit_c])
+        r0, r1 = all_r.min(), all_r.max() + 1
+        c0, c1 = all_c.min(), all_c.max() + 1
         mark = np.zeros((r1 - r0, c1 - c0), dtype=np.int8)
-        mark[free_rc[:, 0] - r0, free_rc[:, 1] - c0] = 1
-        mark[hit_rc[:, 0] - r0, hit_rc[:, 1] - c0] = 2
+        mark[free_r - r0, free_c - c0] = 1
+        mark[hit_r - r0, hit_c - c0] = 2
         window = self.log_odds[r0:r1, c0:c1]
         lo, hi = self.params.clamp
         free, occupied = mark == 1, mark == 2
@@ -168,10 +168,17 @@ class OccupancyGrid:
         window[occupied] = np.minimum(window[occupied] + self.params.l_occ, hi)
         self.version += 1
 
-    def _cells_inside(self, px: np.ndarray, py: np.ndarray) -> np.ndarray:
-        """(row, col) (N, 2) of the in-bounds cells holding world points (px, py)."""
-        rc = self.world_to_cell(np.stack([px, py], axis=1))
-        return rc[self.in_bounds(rc)]
+    def _cells_where(self, px: np.ndarray, py: np.ndarray, where: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(rows, cols) of the in-bounds cells holding the world points (px, py) (m) selected by ``where``.
+
+        The same cells as :meth:`world_to_cell` gives, computed on the arrays as they are (no stacking).
+        """
+        x0, y0 = self.origin
+        rows, cols = self.shape
+        col = np.floor((px - x0) / self.resolution).astype(int)
+        row_up = np.floor((py - y0) / self.resolution).astype(int)
+        keep = where & (col >= 0) & (col < cols) & (row_up >= 0) & (row_up < rows)
+        return rows - 1 - row_up[keep], col[keep]
 
     def occupied_mask(self) -> np.ndarray:
         """Bool (rows, cols): cells believed occupied."""

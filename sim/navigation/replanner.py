@@ -96,6 +96,7 @@ class Replanner:
         self._planned_at: float | None = None
         self._planned_goal: np.ndarray | None = None
         self._forced = False
+        self._clear_at: int | None = None  # the map version at which the current plan was last found clear
 
     def request(self) -> None:
         """Re-plan at the next :meth:`update` (e.g. after a recovery manoeuvre)."""
@@ -116,8 +117,12 @@ class Replanner:
             return "goal moved"
         if self.plan is None:
             return "previous attempt failed" if t - self._planned_at >= self.params.period_s else None
-        if self.params.check_blocked and path_blocked(grid, self.plan.waypoints, self.planner_params, robot):
-            return "path blocked"
+        # The part of the path ahead only shrinks as the robot follows it, so a path found clear is checked
+        # again only once the map (OccupancyGrid.version) or the plan changed.
+        if self.params.check_blocked and self._clear_at != grid.version:
+            if path_blocked(grid, self.plan.waypoints, self.planner_params, robot):
+                return "path blocked"
+            self._clear_at = grid.version
         if _distance_to_polyline(robot, self.plan.waypoints) > self.params.off_path_m:
             return "off path"
         if t - self._planned_at >= self.params.period_s:
@@ -134,6 +139,7 @@ class Replanner:
             self._planned_at = t
             self._planned_goal = as_point(goal_xy, "goal_xy")
             self._forced = False
+            self._clear_at = None
         return self.plan
 
 

@@ -64,3 +64,12 @@ def test_the_command_line_prints_one_line_and_exits_2(tmp_path, capsys):
     assert main(["study", "--world", "zoo", "--navigator", "teleport", "--out", str(tmp_path / "y")]) == 2
     assert "teleport" in capsys.readouterr().err
     assert not (tmp_path / "x").exists() and not (tmp_path / "y" / "settings.json").exists()
+
+
+def test_trial_command_knows_the_navigators(tiny_world, tmp_path, capsys):
+    assert main(["trial", "--world", str(tiny_world.root), "--goal", "A", "--navigator", "teleport",
+                 "--out", str(tmp_path / "t")]) == 2
+    assert "teleport" in capsys.readouterr().err
+    assert main(["trial", "--world", str(tiny_world.root), "--goal", "A", "--navigator", "frontier",
+                 "--perception", "geometric", "--out", str(tmp_path / "f")]) == 0
+    assert '"navigator": "frontier"' in (tmp_path / "f" / "result.json").read_text()
