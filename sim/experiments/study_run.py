@@ -82,14 +82,20 @@ def plan_study(worlds: list[World], settings: StudySettings) -> list[TrialSpec]:
         if unknown:
             known = sorted({g for w in worlds for g in w.goals})[:20]
             raise ValueError(f"--goals: {unknown} in none of the worlds; goals include {known}")
-    specs: list[TrialSpec] = []
+    per_world: list[list[TrialSpec]] = []
     for world in worlds:
         goals = [g for g in world.goals if settings.goals is None or g in settings.goals]
-        if not goals:
-            continue
-        specs += plan_specs(world, settings.trials, settings.perception, goals=goals,
-                            navigators=settings.navigators, oracle_m=world_oracles(world, goals))
-    return specs
+        if goals:
+            per_world.append(plan_specs(world, settings.trials, settings.perception, goals=goals,
+                                        navigators=settings.navigators, oracle_m=world_oracles(world, goals)))
+    # Round robin over worlds (each world's first goal and seed for every navigator, then the next...), so
+    # the trials finished when a long study is stopped early spread over every world, style and signage level.
+    navigators = {name: k for k, name in enumerate(dict.fromkeys(settings.navigators))}
+    order = []
+    for w, specs in enumerate(per_world):
+        goals = {goal: k for k, goal in enumerate(dict.fromkeys(spec.goal for spec in specs))}
+        order += [((spec.seed, goals[spec.goal], w, navigators[spec.navigator]), spec) for spec in specs]
+    return [spec for _, spec in sorted(order, key=lambda pair: pair[0])]
 
 
 def write_outputs(out: Path, records: list[dict[str, Any]], worlds: list[World], settings: StudySettings,
