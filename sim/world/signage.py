@@ -21,9 +21,10 @@ from abstract_map.hierarchy import Hierarchy
 from abstract_map.prepositions import PREPOSITIONS
 from sim.world.data import Floorplan, Tag
 from sim.world.layout import TAG_FRONT_M, Layout, Node
-from sim.world.truth import Facts, RouteField, Routes, first_leg, nearest_arrow, phrase_verdict, place_tags
+from sim.world.truth import Facts, RouteField, Routes, first_leg, hang, nearest_arrow, phrase_verdict, place_tags
 
-SLACK = 0.7  # the generator writes what is true with 70 % of the check's tolerance
+SLACK = 0.7  # the generator writes phrases true with 70 % of the check's tolerance
+ARROW_SLACK = 40.0 / 45.0  # and arrows within 40 of the 45 degrees (routes are recomputed exactly by the check)
 ARROW_ORDER = ("LEFT", "UP", "RIGHT", "DOWN")
 PHRASE_ROWS = ("past", "before", "left of", "right of", "beside", "between")
 NEARBY_M = 14.0  # m, phrases name places this close to the sign
@@ -82,8 +83,9 @@ def sign_spots(layout: Layout, plan: Floorplan, routes: Routes) -> list[SignSpot
     half = layout.widths_x[entrance_node[0]] / 2
     for dy in (2.0, 3.0, 4.0, 1.5, 5.0):
         for side in (1, -1):
-            spot = SignSpot(x_e + side * (half - TAG_FRONT_M), y_s + dy, math.pi if side > 0 else 0.0, None)
-            if _wall_ok(plan, spot.x, spot.y, spot.theta) and routes.reading_pose(_tag(spot)) is not None:
+            spot = SignSpot(round(x_e + side * (half - TAG_FRONT_M), 4), round(y_s + dy, 4),
+                            math.pi if side > 0 else 0.0, None)
+            if _wall_ok(plan, spot.x, spot.y, spot.theta) and routes.reading_pose(_tag(spot, plan)) is not None:
                 spots.append(spot)
                 break
         if spots:
@@ -109,8 +111,9 @@ def _shortest_paths(g, source):  # type: ignore[no-untyped-def]
     return nx.single_source_dijkstra_path(g, source, weight=length)
 
 
-def _tag(spot: SignSpot, tag_id: int = -1, text: str = "", kind: str = "sign") -> Tag:
-    return Tag(tag_id, spot.x, spot.y, spot.theta, kind, text)
+def _tag(spot: SignSpot, plan: Floorplan) -> Tag:
+    """The sign's tag where the check and the scene hang it (its written position rounded as in tags.json)."""
+    return hang(plan, Tag(-1, round(spot.x, 4), round(spot.y, 4), spot.theta, "sign", ""))[0]
 
 
 def _junction_spot(layout: Layout, plan: Floorplan, routes: Routes, node: Node, d: np.ndarray) -> SignSpot | None:
@@ -130,7 +133,7 @@ def _junction_spot(layout: Layout, plan: Floorplan, routes: Routes, node: Node, 
             candidates.append(face + p * (along_half + extra))
     for c in candidates:
         spot = SignSpot(round(float(c[0]), 4), round(float(c[1]), 4), theta, node)
-        if _wall_ok(plan, spot.x, spot.y, spot.theta) and routes.reading_pose(_tag(spot)) is not None:
+        if _wall_ok(plan, spot.x, spot.y, spot.theta) and routes.reading_pose(_tag(spot, plan)) is not None:
             return spot
     return None
 
@@ -141,7 +144,8 @@ class Writer:
 
     facts: Facts
     routes: Routes
-    tags: dict[int, Tag]  # the labels so far
+    plan: Floorplan
+    tags: dict[int, Tag]  # the labels, where they hang
     rng: np.random.Generator
     used_rows: dict[str, int] = field(default_factory=lambda: {r: 0 for r in PHRASE_ROWS})
     used_words: dict[str, int] = field(default_factory=dict)
@@ -155,7 +159,7 @@ class Writer:
         """Add an arrow for each name that ``truth`` calls clearly true from this sign; return the names left out."""
         key = (sign.spot.x, sign.spot.y, sign.spot.theta)
         if key not in self._fields:
-            pose = self.routes.reading_pose(_tag(sign.spot))
+            pose = self.routes.reading_pose(_tag(sign.spot, self.plan))
             self._fields[key] = self.routes.field_from(pose) if pose is not None else None
         field_ = self._fields[key]
         skipped = []
@@ -169,7 +173,7 @@ class Writer:
                 skipped.append(name)
                 continue
             arrow, error = nearest_arrow(sign.spot.theta, leg)
-            if error > SLACK * self.routes.params.tolerance_deg:
+            if error > ARROW_SLACK * self.routes.params.tolerance_deg:
                 skipped.append(name)
                 continue
             sign.arrows.setdefault(arrow, []).append(name)
