@@ -24,7 +24,7 @@ Tests (``tolerance_deg`` 45 by default; F the figure, R a referent, C the contex
 
 Arrows: the reader stands ``reading_m`` in front of the sign (or, when that is
 within the robot's radius of a wall, at the first free cell farther out along
-the normal, up to the reading range). The route to a place is the shortest
+the normal, up to the reading range), at the centre of that route-grid cell. The route to a place is the shortest
 collision-free path (the oracle's distance field, robot inflated) from there to
 the nearest cell that can read a label of the place or of any place in it. Its
 first leg is the first segment of the route simplified by ``simplify_m``
@@ -47,7 +47,7 @@ from shapely.geometry import LineString
 from abstract_map.hierarchy import Hierarchy
 from abstract_map.prepositions import ARROWS, PREPOSITIONS, TABLE
 from sim.world.data import Floorplan, Tag
-from sim.world.oracle import OracleParams, distance_field, free_cells, nearest_cell, pool_plan, readable_cells
+from sim.world.oracle import OracleParams, distance_field, free_cells, pool_plan, readable_cells
 
 
 @dataclass(frozen=True)
@@ -300,13 +300,13 @@ class Routes:
         self.params = params or TruthParams()
         self.grid = pool_plan(plan, self.params.route_cell_m)
         self.free = free_cells(self.grid, self.params.robot_radius_m)
-        self._readable: dict[tuple[int, float, float, float], np.ndarray] = {}
+        self._readable: dict[tuple[int, float, float, float], np.ndarray] = {}  # tag pose -> readable free cells
 
     def readable(self, tag: Tag) -> np.ndarray:
-        """Free cells that can read ``tag`` (cached by tag pose)."""
+        """(row, col) of the free cells that can read ``tag`` (cached by tag pose)."""
         key = (tag.id, tag.x, tag.y, tag.theta)
         if key not in self._readable:
-            self._readable[key] = readable_cells(self.grid, tag, self.params.oracle) & self.free
+            self._readable[key] = np.argwhere(readable_cells(self.grid, tag, self.params.oracle) & self.free)
         return self._readable[key]
 
     def cell(self, xy: np.ndarray) -> tuple[int, int] | None:
@@ -323,8 +323,9 @@ class Routes:
         steps = [self.params.reading_m] + list(np.arange(self.params.robot_radius_m, self.params.read_range_m,
                                                          self.grid.resolution / 2))
         for s in steps:
-            if self.cell(origin + s * n) is not None:
-                return origin + s * n
+            cell = self.cell(origin + s * n)
+            if cell is not None:
+                return self.grid.pixel_to_world(np.array([cell]))[0]  # the cell's centre: robust to mm shifts
         return None
 
     def field_from(self, xy: np.ndarray) -> RouteField | None:
@@ -344,11 +345,19 @@ class RouteField:
     cumulative: np.ndarray
     mcp: object
 
+    def _nearest(self, tag: Tag) -> tuple[float, tuple[int, int]] | None:
+        cells = self.routes.readable(tag)
+        if len(cells) == 0:
+            return None
+        costs = self.cumulative[cells[:, 0], cells[:, 1]]
+        i = int(np.argmin(costs))
+        return (float(costs[i]), (int(cells[i, 0]), int(cells[i, 1]))) if np.isfinite(costs[i]) else None
+
     def route_to(self, tags: list[Tag]) -> np.ndarray | None:
         """The shortest route (N, 2) m to a cell reading any of ``tags``, or None when none is reachable."""
         best: tuple[float, tuple[int, int]] | None = None
         for tag in tags:
-            found = nearest_cell(self.cumulative, self.routes.readable(tag))
+            found = self._nearest(tag)
             if found is not None and (best is None or found[0] < best[0]):
                 best = found
         if best is None:
@@ -359,7 +368,7 @@ class RouteField:
         return path
 
     def reaches(self, tag: Tag) -> bool:
-        return nearest_cell(self.cumulative, self.routes.readable(tag)) is not None
+        return self._nearest(tag) is not None
 
 
 def first_leg(path: np.ndarray, target: np.ndarray | None, params: TruthParams) -> float | None:
