@@ -1,9 +1,10 @@
 """One closed-loop trial: camera -> tags -> abstract map -> planner -> wheels, in pybullet.
 
-:func:`run_trial` builds the world, puts the robot at the start, and runs the
+:class:`Trial` builds the world, puts the robot at the start, and steps the
 control loop at ``control_hz`` of simulated time until the goal's label is
 read, or a cap on simulated time or distance is hit, or exploration is
-exhausted. It never waits on anything but the simulator's own steps.
+exhausted; :func:`run_trial` runs one to the end with the navigator driving.
+It never waits on anything but the simulator's own steps.
 """
 
 from __future__ import annotations
@@ -16,14 +17,14 @@ from typing import Any
 
 import numpy as np
 
-from abstract_map.model import imagined_positions
 from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
-from sim.navigation.follower import FollowerParams, PathFollower, Recovery, RecoveryParams, StuckDetector, StuckParams
-from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
+from sim.navigation.follower import FollowerParams
+from sim.navigation.navigator import CueEvent, NavigatorParams
 from sim.navigation.planner import PlannerParams
-from sim.navigation.replanner import Replanner, ReplanParams
-from sim.navigation.targeting import Target, TargetParams, choose_target
-from sim.perception import GeometricParams, make_perception
+from sim.navigation.policies import PolicyParams, make_policy
+from sim.navigation.replanner import ReplanParams
+from sim.navigation.targeting import TargetParams
+from sim.perception import GeometricParams, Sighting, make_perception
 from sim.perception.laser import LaserParams, laser_angles, scan
 from sim.world.data import World, load_world
 from sim.world.robot import Robot, RobotParams
@@ -120,135 +121,168 @@ def _start_pose(world: World, params: TrialParams, rng: np.random.Generator) -> 
             theta + math.radians(rng.normal(0.0, params.start_jitter_deg)) if params.start_jitter_deg else theta)
 
 
+Observer = Callable[["Trial"], None]
+"""Called after every control tick with the trial (for recordings); must not change it."""
+
+
+class Trial:
+    """One closed-loop trial, stepped one control tick at a time.
+
+    Construction builds the world, puts the robot at the (jittered) start and
+    takes the first look (laser and tags at t = 0). Each :meth:`step` drives
+    for one tick with the given ``(v, w)`` command (m/s, rad/s; the robot's
+    limits apply) or, without one, with the navigator's own command, then
+    senses at the rates in :class:`TrialParams`. :attr:`done` turns true when
+    the goal's label is read, a cap is hit or exploration is exhausted, with
+    :attr:`reason` saying which. Always :meth:`close` it (or use ``with``).
+    """
+
+    def __init__(self, world: World | str, goal: str, *, seed: int = 0, perception: str = "camera",
+                 navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
+                 record: bool = False) -> None:
+        self.began = time.perf_counter()
+        self.world = load_world(world) if isinstance(world, str) else world
+        self.params = params = params or TrialParams()
+        if goal not in self.world.goals and not self.world.label_tags(goal):
+            raise ValueError(f"goal {goal!r}: no label in world {self.world.name!r}; "
+                             f"study goals: {sorted(self.world.goals)}")
+        self.goal, self.seed, self.mode = goal, seed, perception
+        self.progress, self.record = progress, record
+        self.observers: list[Observer] = []
+        self.rng = rng = np.random.default_rng(seed)
+        self.start = _start_pose(self.world, params, rng)
+        self.scene = scene = build_scene(self.world)
+        try:
+            self.robot = Robot(scene, params=RobotParams(odometry_noise_m=params.odometry_noise_m), rng=rng)
+            self.robot.reset(*self.start)
+            self.sensor = make_perception(perception, scene, rng=rng, **_perception_kwargs(perception, params))
+        except BaseException:
+            scene.close()
+            raise
+        x0, x1, y0, y1 = self.world.floorplan.extent
+        self.grid = OccupancyGrid(OccupancyParams(resolution_m=params.occupancy_resolution_m, bounds=(x0, x1, y0, y1)))
+        self.angles = laser_angles(params.laser)
+        self.navigator = navigator
+        self.policy = make_policy(navigator, self.world, goal, self.start, PolicyParams(
+            params.navigator, params.planner, params.replan, params.follower, params.targeting,
+            params.target_recheck_s))
+        self.goal_tags = {tag.id for tag in self.world.tags.values()
+                          if tag.kind == "label" and tag.text.casefold() == goal.casefold()}
+        self.success = False
+        self.steps_per_tick = max(1, round(1.0 / params.control_hz / scene.time_step))
+        self.tick = self.steps_per_tick * scene.time_step  # s of simulated time per step
+        self.every = {name: max(1, round(params.control_hz / hz)) for name, hz in
+                      (("map", params.mapping_hz), ("see", params.perception_hz), ("traj", params.trajectory_hz))}
+        self.frame_every = max(1, round(params.record_every_s / self.tick))
+        self.t, self.distance, self.n = 0.0, 0.0, 0
+        self.last = self.robot.true_pose()
+        self.trajectory: list[tuple[float, float, float, float]] = [(0.0, *self.last)]
+        self.frames: list[Frame] = []
+        self.reason = ""
+        self.scan: np.ndarray | None = None  # m, the latest laser ranges
+        self.sightings: list[Sighting] = []  # the tags read at the latest look
+        self._sense()
+
+    @property
+    def done(self) -> bool:
+        return bool(self.reason)
+
+    def __enter__(self) -> Trial:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        self.scene.close()
+
+    def _cast(self, origins: np.ndarray, ends: np.ndarray) -> np.ndarray:
+        z = np.full((len(origins), 1), self.params.laser.height_m)
+        return self.scene.ray_fractions(np.hstack([origins, z]), np.hstack([ends, z]))
+
+    def _sense(self) -> None:
+        """Laser and tags at their rates, then the success and cap checks."""
+        params, pose = self.params, self.robot.pose()
+        self.sightings = []
+        if self.n % self.every["map"] == 0:
+            self.scan = scan(pose, self._cast, params.laser, self.rng)
+            self.grid.integrate(pose, self.angles, self.scan, params.laser.max_range_m)
+        if self.n % self.every["see"] == 0:
+            self.sightings = self.sensor.observe(self.robot)
+            self.policy.observe(self.sightings, t_s=self.t, distance_m=self.distance, grid=self.grid)
+            if any(s.tag_id in self.goal_tags for s in self.sightings):
+                self.success = True
+                self.reason = "goal label read"
+                return
+        if self.t >= params.max_sim_s:
+            self.reason = f"simulated time cap of {params.max_sim_s:.0f} s reached"
+        elif self.distance >= params.max_distance_m:
+            self.reason = f"distance cap of {params.max_distance_m:.0f} m reached"
+
+    def command(self) -> tuple[float, float]:
+        """The navigator's own (v, w) for this tick (m/s, rad/s); may end the trial (the navigator gave up)."""
+        v, w = self.policy.command(self.t, self.robot.pose(), self.grid, self.tick, self.rng)
+        if self.policy.gave_up:
+            self.reason = self.policy.gave_up
+        return v, w
+
+    def step(self, command: tuple[float, float] | None = None) -> bool:
+        """Drive one tick with ``command`` (m/s, rad/s) or the navigator's own; sense. True when done."""
+        if self.done:
+            raise RuntimeError(f"trial already ended: {self.reason}")
+        v, w = self.command() if command is None else command
+        if self.done:
+            return True
+        self.robot.command(v, w)
+        self.scene.step(self.steps_per_tick)
+        self.t += self.tick
+        self.n += 1
+        now = self.robot.true_pose()
+        self.distance += math.hypot(now[0] - self.last[0], now[1] - self.last[1])
+        self.last = now
+        if self.n % self.every["traj"] == 0:
+            self.trajectory.append((self.t, *now))
+        if self.progress and self.n % round(1.0 / self.tick) == 0:
+            self.progress(self.t, self.distance, len(self.policy.cues))
+        if self.record and self.n % self.frame_every == 0:
+            self.frames.append(self.snapshot(now))
+        self._sense()
+        for observer in self.observers:
+            observer(self)
+        return self.done
+
+    def snapshot(self, pose: tuple[float, float, float]) -> Frame:
+        """An animation frame of the trial now."""
+        places, target, path = self.policy.picture()
+        return Frame(self.t, pose, self.grid.to_image(), places, target, path)
+
+    def result(self) -> TrialResult:
+        """What the trial did so far, as written to result.json."""
+        final = self.robot.true_pose()
+        trajectory = [*self.trajectory, (self.t, *final)]
+        frames = [*self.frames, self.snapshot(final)] if self.record else []
+        if self.progress:
+            self.progress(self.t, self.distance, len(self.policy.cues))
+        settle_ms = self.policy.settle_ms()
+        return TrialResult(
+            world=self.world.name, goal=self.goal, seed=self.seed, perception=self.mode, success=self.success,
+            reason=self.reason, distance_m=self.distance, sim_s=self.t, wall_s=time.perf_counter() - self.began,
+            start=self.start, cues=self.policy.cues, trajectory=np.array(trajectory),
+            final_positions=self.policy.picture()[0], exploration_bumps=getattr(self.policy, "bumps", 0),
+            settle_median_ms=float(np.median(settle_ms)) if settle_ms else 0.0, frames=frames,
+            grid_extent=self.grid.extent,
+        )
+
+
 def run_trial(world: World | str, goal: str, *, seed: int = 0, perception: str = "camera",
-              params: TrialParams | None = None, progress: Progress | None = None,
+              navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
               record: bool = False) -> TrialResult:
-    """Run one trial of finding ``goal`` in ``world`` and report what happened."""
-    began = time.perf_counter()
-    world = load_world(world) if isinstance(world, str) else world
-    params = params or TrialParams()
-    if goal not in world.goals and not world.label_tags(goal):
-        raise ValueError(f"goal {goal!r}: no label in world {world.name!r}; study goals: {sorted(world.goals)}")
-    rng = np.random.default_rng(seed)
-    start = _start_pose(world, params, rng)
-    scene = build_scene(world)
-    try:
-        return _loop(world, goal, scene, start, rng, seed, perception, params, progress, record, began)
-    finally:
-        scene.close()
-
-
-def _loop(world: World, goal: str, scene: Any, start: tuple[float, float, float], rng: np.random.Generator,
-          seed: int, mode: str, params: TrialParams, progress: Progress | None, record: bool,
-          began: float) -> TrialResult:
-    robot_params = RobotParams(odometry_noise_m=params.odometry_noise_m)
-    robot = Robot(scene, params=robot_params, rng=rng)
-    robot.reset(*start)
-    sensor = make_perception(mode, scene, rng=rng, **_perception_kwargs(mode, params))
-    x0, x1, y0, y1 = world.floorplan.extent
-    grid = OccupancyGrid(OccupancyParams(resolution_m=params.occupancy_resolution_m, bounds=(x0, x1, y0, y1)))
-    angles = laser_angles(params.laser)
-    height = params.laser.height_m
-
-    def cast(origins: np.ndarray, ends: np.ndarray) -> np.ndarray:
-        z = np.full((len(origins), 1), height)
-        return scene.ray_fractions(np.hstack([origins, z]), np.hstack([ends, z]))
-
-    nav = Navigator.start(world, goal, start, params=params.navigator)
-    replanner = Replanner(params.replan, params.planner)
-    follower = PathFollower(params.follower)
-    stuck, recovery = StuckDetector(StuckParams()), Recovery(RecoveryParams())
-
-    tick = 1.0 / params.control_hz
-    steps_per_tick = max(1, round(tick / scene.time_step))
-    tick = steps_per_tick * scene.time_step
-    every = {name: max(1, round(params.control_hz / hz)) for name, hz in
-             (("map", params.mapping_hz), ("see", params.perception_hz), ("traj", params.trajectory_hz))}
-    frame_every = max(1, round(params.record_every_s / tick))
-    t, distance, n, bumps = 0.0, 0.0, 0, 0
-    last = robot.true_pose()
-    trajectory = [(0.0, *last)]
-    frames: list[Frame] = []
-    reason = ""
-    target: Target | None = None
-    target_at = -math.inf
-
-    def snapshot(pose: tuple[float, float, float]) -> Frame:
-        shown = nav.target() if target is None else target.xy
-        return Frame(t, pose, grid.to_image(), dict(imagined_positions(nav.model)), tuple(shown),
-                     None if replanner.plan is None else replanner.plan.waypoints)
-
-    while True:
-        pose = robot.pose()
-        if n % every["map"] == 0:
-            grid.integrate(pose, angles, scan(pose, cast, params.laser, rng), params.laser.max_range_m)
-        if n % every["see"] == 0:
-            if nav.observe(sensor.observe(robot), t_s=t, distance_m=distance, explored_centre=grid.explored_centre):
-                target = None
-            if nav.succeeded:
-                reason = "goal label read"
-                break
-        if t >= params.max_sim_s:
-            reason = f"simulated time cap of {params.max_sim_s:.0f} s reached"
-            break
-        if distance >= params.max_distance_m:
-            reason = f"distance cap of {params.max_distance_m:.0f} m reached"
-            break
-        # A stand-in target is kept until the model changes; the imagined goal is re-checked as the map grows.
-        if target is None or (not target.local and t - target_at >= params.target_recheck_s):
-            detours = nav.bumps_in_a_row >= params.targeting.local_bumps
-            robot_xy = np.array(pose[:2])
-            target = choose_target(grid, robot_xy, nav.target(robot_xy), params.planner, params.targeting,
-                                   allow_detours=detours)
-            target_at = t
-        v = w = 0.0
-        if recovery.active:
-            step = recovery.step(t)
-            v, w = step.v, step.w
-            if step.replan:
-                replanner.request()
-                stuck.reset()
-        else:
-            plan = replanner.update(t, grid, pose[:2], target.xy)
-            arrived = plan is None
-            if plan is not None:
-                v, w, done = follower.command(pose, plan.waypoints, tick)
-                arrived = done and float(np.hypot(*(np.array(plan.goal_xy) - pose[:2]))) < nav.params.arrive_m
-                if stuck.update(t, pose, commanded=abs(v) > 0.01 or abs(w) > 0.01):
-                    recovery.start(t, turn_sign=1.0 if rng.random() < 0.5 else -1.0)
-            if arrived:
-                if not nav.arrived_without_goal(grid.explored_centre()):
-                    reason = "exploration exhausted: the goal was not found where imagined"
-                    break
-                bumps += 1
-                target = None
-                replanner.request()
-        robot.command(v, w)
-        scene.step(steps_per_tick)
-        t += tick
-        n += 1
-        now = robot.true_pose()
-        distance += math.hypot(now[0] - last[0], now[1] - last[1])
-        last = now
-        if n % every["traj"] == 0:
-            trajectory.append((t, *now))
-        if progress and n % round(1.0 / tick) == 0:
-            progress(t, distance, len(nav.cues))
-        if record and n % frame_every == 0:
-            frames.append(snapshot(now))
-    trajectory.append((t, *robot.true_pose()))
-    if record:
-        frames.append(snapshot(robot.true_pose()))
-    if progress:
-        progress(t, distance, len(nav.cues))
-    settle_ms = [s.wall_s * 1000 for s in nav.settles[1:]] or [nav.settles[0].wall_s * 1000]
-    return TrialResult(
-        world=world.name, goal=goal, seed=seed, perception=mode, success=nav.succeeded, reason=reason,
-        distance_m=distance, sim_s=t, wall_s=time.perf_counter() - began, start=start, cues=nav.cues,
-        trajectory=np.array(trajectory), final_positions=dict(imagined_positions(nav.model)),
-        exploration_bumps=bumps, settle_median_ms=float(np.median(settle_ms)), frames=frames,
-        grid_extent=grid.extent,
-    )
+    """Run one trial of finding ``goal`` in ``world`` with the navigator driving, and report what happened."""
+    with Trial(world, goal, seed=seed, perception=perception, navigator=navigator, params=params,
+               progress=progress, record=record) as trial:
+        while not trial.done:
+            trial.step()
+        return trial.result()
 
 
 def _perception_kwargs(mode: str, params: TrialParams) -> dict[str, Any]:
