@@ -131,8 +131,33 @@ def bench_study(trials: int = 1, workers: int = 2, perception: str = "geometric"
           [[str(trials), perception, str(workers), f"{wall:.0f}"]])
 
 
+def bench_generate(seeds: range = range(1000, 1005)) -> None:
+    """Generation time per style and size (median over seeds; CPU time, which load does not inflate, and wall)."""
+    from sim.world.check import check_world
+    from sim.world.generator import generate
+    from sim.world.styles import SIZES, STYLES
+
+    rows = []
+    for size in SIZES:
+        for style in STYLES:
+            cpu, wall, rooms, tags, passed = [], [], [], [], 0
+            for seed in seeds:
+                c0, w0 = time.process_time(), time.perf_counter()
+                g = generate(seed, style=style, size=size)
+                cpu.append(time.process_time() - c0)
+                wall.append(time.perf_counter() - w0)
+                rooms.append(len(g.layout.rooms))
+                tags.append(len(g.world.tags))
+                passed += check_world(g.world, hierarchy=g.hierarchy).ok
+            rows.append([size, style, f"{np.median(cpu):.2f}", f"{max(cpu):.2f}", f"{np.median(wall):.2f}",
+                         f"{min(rooms)}-{max(rooms)}", f"{min(tags)}-{max(tags)}", f"{passed}/{len(seeds)}"])
+    table("Generate", ["size", "style", "median CPU (s)", "max CPU (s)", "median wall (s)", "rooms", "tags",
+                       "pass world check"], rows)
+
+
 BENCHMARKS: dict[str, Callable[[], None]] = {"settle": bench_settle, "scaling": bench_scaling,
-                                             "trials": bench_trials, "study": bench_study}
+                                             "trials": bench_trials, "study": bench_study,
+                                             "generate": bench_generate}
 
 
 def main() -> int:
