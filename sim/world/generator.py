@@ -245,7 +245,7 @@ def generate(seed: int, *, style: str = "office", size: str = "medium", signage:
     others = [g for g in goals if g not in area_only]
     n_area_only = round(level.area_only_fraction * len(others))
     area_only |= {others[k] for k in srng.permutation(len(others))[:n_area_only]}
-    spots = sign_spots(layout, plan, routes)
+    spots = sign_spots(layout, plan, routes, list(tags.values()))
     entrance, junctions = spots[:1] if spots and spots[0].node is None else [], [s for s in spots if s.node is not None]
     if level.drop_fraction > 0:
         drop = set(srng.permutation(len(junctions))[: round(level.drop_fraction * len(junctions))].tolist())
