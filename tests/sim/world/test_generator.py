@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import functools
 import math
-import time
 
 import networkx as nx
 import numpy as np
@@ -73,12 +72,6 @@ def test_every_style_makes_a_world_that_passes_the_check(style, size, seed, tmp_
     if size == "medium":
         rooms = len(g.layout.rooms)
         assert 40 <= g.layout.width <= 70 and 15 <= rooms <= 48 and 25 <= len(world.tags) <= 60
-
-
-def test_medium_generation_is_quick():
-    t0 = time.perf_counter()
-    generate(4242, style="office", size="medium")
-    assert time.perf_counter() - t0 < 10.0  # the README's measured median is well under 5 s; slack for a busy CI
 
 
 def test_goals_are_spread_behind_a_loop_off_a_dead_end_and_named_by_no_arrow():
