@@ -3,7 +3,11 @@
 from __future__ import annotations
 
 import functools
+import hashlib
 import math
+import os
+import subprocess
+import sys
 
 import networkx as nx
 import numpy as np
@@ -51,6 +55,16 @@ def test_same_seed_same_bytes_and_names_are_unique():
 
 
 @pytest.mark.parametrize("style, size, seed", STYLE_CASES)
+def test_same_bytes_in_another_process_with_another_hash_seed():
+    script = ("import hashlib, sys; from sim.world.generator import generate; "
+              "g = generate(7, style='campus', size='small', signage='misleading'); "
+              "sys.stdout.write(hashlib.sha256(b''.join(g.files[k] for k in sorted(g.files))).hexdigest())")
+    digests = {subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True,
+                              env={**os.environ, "PYTHONHASHSEED": seed}).stdout for seed in ("1", "2")}
+    here = made(7, "campus", "small", "misleading")
+    assert digests == {hashlib.sha256(b"".join(here.files[k] for k in sorted(here.files))).hexdigest()}
+
+
 def test_every_style_makes_a_world_that_passes_the_check(style, size, seed, tmp_path):
     g = made(seed, style, size)
     report = checked(seed, style, size)
