@@ -54,7 +54,6 @@ def test_same_seed_same_bytes_and_names_are_unique():
     assert b'"name": "gen-hospital-small-complete-5"' in a.files["world.json"]
 
 
-@pytest.mark.parametrize("style, size, seed", STYLE_CASES)
 def test_same_bytes_in_another_process_with_another_hash_seed():
     script = ("import hashlib, sys; from sim.world.generator import generate; "
               "g = generate(7, style='campus', size='small', signage='misleading'); "
@@ -65,6 +64,7 @@ def test_same_bytes_in_another_process_with_another_hash_seed():
     assert digests == {hashlib.sha256(b"".join(here.files[k] for k in sorted(here.files))).hexdigest()}
 
 
+@pytest.mark.parametrize("style, size, seed", STYLE_CASES)
 def test_every_style_makes_a_world_that_passes_the_check(style, size, seed, tmp_path):
     g = made(seed, style, size)
     report = checked(seed, style, size)
