@@ -2,8 +2,8 @@
 
 Run from the repository root:
 
-    python benchmarks/run.py                  # settle, scaling, trials, study (about 10 minutes on 2 cores)
-    python benchmarks/run.py settle scaling   # just some of: settle, scaling, trials, study, generalise
+    python benchmarks/run.py                  # settle, scaling, trials, study, generate (10-15 minutes on 2 cores)
+    python benchmarks/run.py settle scaling   # just some of: settle, scaling, trials, study, generate, generalise
     python benchmarks/run.py generalise       # the generalisation benchmark (within an hour on 2 cores)
     python benchmarks/run.py generalise --buildings 6 --camera-buildings 2   # a quick run
 
@@ -12,6 +12,7 @@ scaling  settle time as the model grows: synthetic hierarchies of about 50, 500,
          (a few minutes: the 5,000-place model takes about 13 ms per integration step)
 trials   wall time and real-time factor of the Lion trial, per perception mode
 study    total wall time of a small study (1 trial per goal, geometric, 2 workers)
+generate time to generate a building per style and size, and how many pass the world check
 generalise  test buildings (seeds 1000-1049, styles and signage levels cycling), 5 goals each, geometric
          perception, navigators paper and frontier; then 10 of them (1000-1009) with the camera and the paper
          navigator. Success, SPL, ratio to oracle and wall time per navigator and signage level, and per style.
@@ -213,8 +214,33 @@ def bench_generalise(buildings: int = 50, camera_buildings: int = 10, workers: i
     print(f"benchmark wall time: {wall / 60:.1f} min (trials resumed from {out} not counted)")
 
 
+def bench_generate(seeds: range = range(1000, 1005)) -> None:
+    """Generation time per style and size (median over seeds; CPU time, which load does not inflate, and wall)."""
+    from sim.world.check import check_world
+    from sim.world.generator import generate
+    from sim.world.styles import SIZES, STYLES
+
+    rows = []
+    for size in SIZES:
+        for style in STYLES:
+            cpu, wall, rooms, tags, passed = [], [], [], [], 0
+            for seed in seeds:
+                c0, w0 = time.process_time(), time.perf_counter()
+                g = generate(seed, style=style, size=size)
+                cpu.append(time.process_time() - c0)
+                wall.append(time.perf_counter() - w0)
+                rooms.append(len(g.layout.rooms))
+                tags.append(len(g.world.tags))
+                passed += check_world(g.world, hierarchy=g.hierarchy).ok
+            rows.append([size, style, f"{np.median(cpu):.2f}", f"{max(cpu):.2f}", f"{np.median(wall):.2f}",
+                         f"{min(rooms)}-{max(rooms)}", f"{min(tags)}-{max(tags)}", f"{passed}/{len(seeds)}"])
+    table("Generate", ["size", "style", "median CPU (s)", "max CPU (s)", "median wall (s)", "rooms", "tags",
+                       "pass world check"], rows)
+
+
 BENCHMARKS: dict[str, Callable[[], None]] = {"settle": bench_settle, "scaling": bench_scaling,
-                                             "trials": bench_trials, "study": bench_study}
+                                             "trials": bench_trials, "study": bench_study,
+                                             "generate": bench_generate}
 NAMED_ONLY = ("generalise",)  # too long for the default set; run by name
 
 
