@@ -167,8 +167,8 @@ def test_multi_world_study_resumes_across_worlds_and_refuses_other_settings(tiny
     settings = settings_for(tiny_world, worlds=(str(tiny_world.root), str(twin)), navigators=("paper", "frontier"))
     out = tmp_path / "study"
     first = conduct_study(settings, out, workers=1)
-    assert sorted((r["world"], r["navigator"]) for r in first.records) == [
-        ("tiny", "frontier"), ("tiny", "paper"), ("twin", "frontier"), ("twin", "paper")]
+    assert [(r["world"], r["navigator"]) for r in first.records] == [  # round robin over worlds
+        ("tiny", "paper"), ("tiny", "frontier"), ("twin", "paper"), ("twin", "frontier")]
     assert all(r["oracle_m"] > 0 and r["spl"] is not None for r in first.records)
     rows = list(csv.DictReader((out / "trials.csv").open()))
     assert {"world", "navigator", "oracle_m", "spl", "goal", "seed", "distance_m", "reason"} <= set(rows[0])
@@ -210,3 +210,18 @@ def test_summary_groups_scores_and_lists_the_worst(tmp_path):
     assert "| frontier | distance cap of N m reached | 1 |" in text
     assert "[path](w/1.png)" in text
     assert "| paper | 100% (2/2) | 0.88 | 1.17 |" in text
+
+
+def test_plan_goes_round_robin_over_worlds(tiny_world, tmp_path):
+    from sim.experiments.study_run import plan_study
+    from sim.world.data import load_world
+
+    twin = tmp_path / "twin"
+    shutil.copytree(tiny_world.root, twin)
+    (twin / "world.json").write_text((twin / "world.json").read_text().replace('"name": "tiny"', '"name": "twin"'))
+    settings = settings_for(tiny_world, trials=2, navigators=("paper", "frontier"))
+    specs = plan_study([tiny_world, load_world(twin)], settings)
+    assert [(s.seed, s.name, s.navigator) for s in specs] == [
+        (0, "tiny", "paper"), (0, "tiny", "frontier"), (0, "twin", "paper"), (0, "twin", "frontier"),
+        (1, "tiny", "paper"), (1, "tiny", "frontier"), (1, "twin", "paper"), (1, "twin", "frontier")]
+    assert all(s.oracle_m and s.oracle_m > 0 for s in specs)
