@@ -69,6 +69,12 @@ class GeneratedWorld:
     goal_roles: dict[str, str]  # goal -> "loop" | "dead end" | "no arrow" | "hall" | "through room" | "far"
     misleading: list[dict[str, Any]]  # {"tag", "name", "arrow"}: arrows written wrong on purpose
 
+    def check(self):  # type: ignore[no-untyped-def]
+        """``check_world`` on the world in memory (its hierarchy is not on disk): a ``CheckReport``."""
+        from sim.world.check import check_world
+
+        return check_world(self.world, hierarchy=self.hierarchy)
+
 
 def world_name(seed: int, style: str, size: str, signage: str) -> str:
     return f"gen-{style}-{size}-{signage}-{seed}"
