@@ -262,19 +262,26 @@ def generate(seed: int, *, style: str = "office", size: str = "medium", signage:
                          | {r.name for r in layout.rooms if r.name not in area_only})
     extras_pool = [n for n in extras_pool if n not in area_only and n not in hierarchy.roots()]
     signs: list[Sign] = []
-    for spot in entrance + junctions:
-        sign = Sign(spot)
+    for first in entrance + junctions:
+        wanted = list(dict.fromkeys(area_of[g] if g in area_only else g for g in goals
+                                    if first.node is None or _passes(oracle[g].path, layout, first.node)))
+        best: tuple[int, Sign] | None = None
+        for spot in [first, *first.alternates]:  # another wall of the junction when a goal cannot be pointed at
+            sign = Sign(spot)
+            for name in writer.arrows(sign, wanted):  # the goal itself when its area cannot be pointed at
+                goal = next((g for g in goals if area_of[g] == name and g not in area_only), None)
+                if goal is not None:
+                    writer.arrows(sign, [goal])
+            named = sum(1 for g in goals if (area_of[g] if g in area_only else g) in wanted
+                        and ({g, area_of[g]} & sign.names()))
+            if best is None or named > best[0]:
+                best = (named, sign)
+            if named == sum(1 for g in goals if (area_of[g] if g in area_only else g) in wanted):
+                break
+        assert best is not None
+        sign = best[1]
+        spot = sign.spot
         here = np.array([spot.x, spot.y])
-        wanted = []
-        for g in goals:
-            passes = spot.node is None or _passes(oracle[g].path, layout, spot.node)
-            if passes:
-                wanted.append(area_of[g] if g in area_only else g)
-        skipped = writer.arrows(sign, list(dict.fromkeys(wanted)))
-        for name in skipped:  # the goal itself when its area cannot be pointed at clearly, or vice versa
-            goal = next((g for g in goals if area_of[g] == name and g not in area_only), None)
-            if goal is not None:
-                writer.arrows(sign, [goal])
         pool = [n for n in extras_pool if n not in sign.names()]
         pool.sort(key=lambda n: float(np.hypot(*(facts.positions[n] - here))) if n in facts.positions else 1e9)
         pool = pool[:12]
