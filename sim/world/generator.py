@@ -43,10 +43,10 @@ from sim.world.layout import (
     build_layout,
 )
 from sim.world.oracle import oracle_paths
-from sim.world.signage import EXTRA_NAMES, SLACK, Sign, Writer, sign_spots
+from sim.world.signage import EXTRA_NAMES, Sign, Writer, sign_spots
 from sim.world.signage import _tag as _sign_tag
 from sim.world.styles import SIGNAGE, SIZES, STYLES, Size, Style, lookup
-from sim.world.truth import Facts, Routes, TruthParams, arrow_direction, hang, nearest_arrow, place_positions
+from sim.world.truth import Facts, Routes, TruthParams, arrow_direction, hang, place_positions
 
 FILES = ("world.json", "floorplan.png", "tags.json", "hierarchy.xml")
 N_TAG_IDS = 587  # AprilTag 36h11 has ids 0-586
@@ -210,10 +210,6 @@ def _png(image: np.ndarray) -> bytes:
     return buffer.getvalue()
 
 
-def _hierarchy_object(nested: dict[str, Any]) -> Hierarchy:
-    return Hierarchy.from_nested(nested)
-
-
 def generate(seed: int, *, style: str = "office", size: str = "medium", signage: str = "complete") -> GeneratedWorld:
     """A building from ``seed`` (module docstring); pure: no files, same arguments, same bytes."""
     style_spec: Style = lookup(STYLES, style, "style")
@@ -225,7 +221,7 @@ def generate(seed: int, *, style: str = "office", size: str = "medium", signage:
     layout = build_layout(style_spec, size_spec, rng)
     goal_roles = _choose_goals(layout, rng)
     nested = _hierarchy(style_spec, size_spec, layout, rng)
-    hierarchy = _hierarchy_object(nested)
+    hierarchy = Hierarchy.from_nested(nested)
     image = layout.raster()
     plan = Floorplan(image < 128, RESOLUTION_M, (0.0, 0.0))
     params = TruthParams()
@@ -432,5 +428,4 @@ def generated_world(seed: int, *, style: str = "office", size: str = "medium", s
     return write_world(generate(seed, style=style, size=size, signage=signage), folder)
 
 
-__all__ = ["GeneratedWorld", "generate", "write_world", "generated_world", "world_name", "SLACK",
-           "nearest_arrow"]
+__all__ = ["GeneratedWorld", "generate", "write_world", "generated_world", "world_name"]
