@@ -14,6 +14,8 @@ import sys
 from collections.abc import Sequence
 from types import ModuleType
 
+from .errors import AbstractMapError, one_line
+
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "imagine": ("abstract_map.imagine_command", "replay a scenario of cues and write the imagined map after each"),
     "trial": ("sim.trial_command", "run one closed-loop trial in a pybullet world (needs the [sim] extra)"),
@@ -21,7 +23,7 @@ SUBCOMMANDS: dict[str, tuple[str, str]] = {
 }
 
 
-class ExitError(Exception):
+class ExitError(AbstractMapError):
     """An error for the user: printed as one line, exit code 2."""
 
 
@@ -64,8 +66,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     try:
         return int(args.run(args))
-    except ExitError as exc:
-        print(f"abstract-map {args.command}: {exc}", file=sys.stderr)
+    except AbstractMapError as exc:
+        print(one_line(f"abstract-map {args.command}: {exc}"), file=sys.stderr)
         return 2
 
 

@@ -20,12 +20,14 @@ import math
 import re
 from dataclasses import dataclass
 
-from .clauses import ANCHOR_PREFIX, Clause, Locational, Relational
+from .clauses import Clause, Locational, Relational
+from .errors import CueError, place_name, show
 from .prepositions import ARROWS, HERE_WORDS, TABLE
 
+__all__ = ["Anchor", "CueError", "parse_cue", "parse_line", "split_lines"]
 
-class CueError(ValueError):
-    """Cue text that the grammar cannot turn into clauses."""
+MAX_CUE_CHARS = 100_000
+"""Characters in one cue's text: far more than any sign (the zoo's longest has 120)."""
 
 
 @dataclass(frozen=True)
@@ -38,7 +40,7 @@ class Anchor:
     theta: float  # rad
 
     def __post_init__(self) -> None:
-        if not all(math.isfinite(v) for v in (self.x, self.y, self.theta)):
+        if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in (self.x, self.y, self.theta)):
             raise CueError(f"anchor {self.name!r}: pose ({self.x}, {self.y}, {self.theta}) must be finite")
 
 
@@ -62,11 +64,7 @@ def split_lines(text: str) -> list[str]:
 def clean_name(name: str, *, where: str) -> str:
     """A place name without its leading article or trailing full stop."""
     cleaned = _ARTICLE.sub("", name.strip().rstrip(".").strip()).strip()
-    if not cleaned:
-        raise CueError(f"{where}: empty place name")
-    if cleaned.startswith(ANCHOR_PREFIX):
-        raise CueError(f"{where}: place name {cleaned!r} may not start with {ANCHOR_PREFIX!r}")
-    return cleaned
+    return place_name(where, cleaned, error=CueError)
 
 
 def split_names(text: str, *, where: str) -> list[str]:
@@ -147,8 +145,12 @@ def looks_like_sign(text: str) -> bool:
 def parse_cue(text: str, anchor: Anchor | None = None, *, kind: str | None = None) -> list[Clause]:
     """Clauses of a cue. ``kind`` is "label", "sign" or None (inferred from the text)."""
     where_tag = f"cue at {anchor.name}" if anchor else "cue"
-    if not isinstance(text, str) or not text.strip():
+    if not isinstance(text, str):
+        raise CueError(f"{where_tag}: text must be a string, got {show(text)}")
+    if not text.strip():
         raise CueError(f"{where_tag}: empty text")
+    if len(text) > MAX_CUE_CHARS:
+        raise CueError(f"{where_tag}: {len(text)} characters; a cue has at most {MAX_CUE_CHARS}")
     if kind is None:
         kind = "sign" if looks_like_sign(text) else "label"
     if kind == "label":
@@ -157,7 +159,7 @@ def parse_cue(text: str, anchor: Anchor | None = None, *, kind: str | None = Non
         name = clean_name(text, where=f"{where_tag} label {text!r}")
         return [Locational("label", name, anchor.name, math.remainder(anchor.theta + math.pi, math.tau))]
     if kind != "sign":
-        raise CueError(f"{where_tag}: kind {kind!r} is not 'label' or 'sign'")
+        raise CueError(f"{where_tag}: kind {show(kind)} is not 'label' or 'sign'")
     clauses: list[Clause] = []
     for number, line in enumerate(split_lines(text), start=1):
         clauses.extend(parse_line(line, anchor, where=f"{where_tag} line {number} {line!r}"))

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from .clauses import tag_anchor
+from .errors import ScenarioError
 from .grammar import Anchor, parse_cue
 from .hierarchy import Hierarchy
 from .model import AbstractMap, SettleReport, imagined_positions
@@ -37,9 +38,6 @@ from .params import AbstractMapParams
 _SCENARIO_KEYS = {"hierarchy", "start", "goal", "steps"}
 _STEP_KEYS = {"text", "tag", "pose", "kind", "explored_centre"}
 
-
-class ScenarioError(ValueError):
-    """A scenario file that cannot be replayed."""
 
 
 @dataclass(frozen=True)
