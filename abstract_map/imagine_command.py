@@ -23,6 +23,8 @@ from .scenario import load_scenario, replay
 
 PLOT_SUFFIXES = ("png", "pdf", "svg", "jpg", "jpeg")
 
+SUMMARY = "replay a scenario of cues and write the imagined map after each"
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scenario", type=Path, help="scenario JSON (hierarchy, start, optional goal, steps)")

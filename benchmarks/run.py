@@ -108,7 +108,7 @@ def bench_scaling(sizes: tuple[int, ...] = (50, 500, 5000)) -> None:
 
 
 def bench_trials(goal: str = "Lion") -> None:
-    from sim.trial import run_trial
+    from sim.experiments.trial import run_trial
 
     rows = []
     for mode in ("geometric", "camera"):

@@ -1,8 +1,10 @@
-"""Perception: which tags the robot reads, as :class:`Sighting` s in the world frame.
+"""Perception: what the robot senses: the tags it reads, and laser scans.
 
-Two modes share ``observe(robot) -> list[Sighting]``: ``"camera"`` renders a
-panoramic camera and detects AprilTags in the images; ``"geometric"`` decides
-from the map (range, reading cone, field of view, line of sight).
+Tags come as :class:`Sighting` s in the world frame. Two modes share
+``observe(robot) -> list[Sighting]``: ``"camera"`` renders a panoramic camera
+and detects AprilTags in the images; ``"geometric"`` decides from the map
+(range, reading cone, field of view, line of sight). The laser (``laser``)
+casts its beams over the floor plan. May import ``sim.world``.
 """
 
 from __future__ import annotations
@@ -12,9 +14,9 @@ from typing import Any, Protocol
 from sim.perception.camera import CameraParams, CameraPerception
 from sim.perception.geometric import GeometricParams, GeometricPerception
 from sim.perception.sighting import Sighting
-from sim.robot import Robot
-from sim.scene import Scene
-from sim.visibility import readable
+from sim.world.robot import Robot
+from sim.world.scene import Scene
+from sim.world.visibility import readable
 
 PERCEPTION_MODES: dict[str, type[CameraPerception] | type[GeometricPerception]] = {
     "camera": CameraPerception,

@@ -26,9 +26,9 @@ import numpy as np
 import pybullet as p
 
 from sim.perception.sighting import Sighting
-from sim.robot import Robot
-from sim.scene import Scene
-from sim.visibility import readable
+from sim.world.robot import Robot
+from sim.world.scene import Scene
+from sim.world.visibility import readable
 
 _REFINEMENT = MappingProxyType({
     "none": cv2.aruco.CORNER_REFINE_NONE,

@@ -18,9 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim.perception.sighting import Sighting
-from sim.robot import Robot
-from sim.scene import Scene
-from sim.visibility import readable
+from sim.world.robot import Robot
+from sim.world.scene import Scene
+from sim.world.visibility import readable
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,7 @@ import pytest
 
 pytest.importorskip("pybullet")
 
-from sim.world_data import World, load_world  # noqa: E402
+from sim.world.data import World, load_world  # noqa: E402
 
 RESOLUTION = 0.05  # m/px
 SIZE = (10.0, 8.0)  # m, x by y
@@ -74,14 +74,14 @@ def write_world(root: Path) -> Path:
 
 @pytest.fixture(scope="session")
 def tiny_world(tmp_path_factory: pytest.TempPathFactory) -> World:
-    """The tiny world, loaded with :func:`sim.world_data.load_world`."""
+    """The tiny world, loaded with :func:`sim.world.data.load_world`."""
     return load_world(write_world(tmp_path_factory.mktemp("worlds") / "tiny"))
 
 
 @pytest.fixture(scope="module")
 def tiny_scene(tiny_world: World):
     """The tiny world built in its own pybullet client, shared by a test module."""
-    from sim.scene import build_scene
+    from sim.world.scene import build_scene
 
     scene = build_scene(tiny_world)
     yield scene

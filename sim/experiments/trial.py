@@ -1,0 +1,293 @@
+"""One closed-loop trial: camera -> tags -> abstract map -> planner -> wheels, in pybullet.
+
+:class:`Trial` builds the world, puts the robot at the start, and steps the
+control loop at ``control_hz`` of simulated time until the goal's label is
+read, or a cap on simulated time or distance is hit, or exploration is
+exhausted; :func:`run_trial` runs one to the end with the navigator driving.
+It never waits on anything but the simulator's own steps.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
+from sim.navigation.follower import FollowerParams
+from sim.navigation.navigator import CueEvent, NavigatorParams
+from sim.navigation.planner import PlannerParams
+from sim.navigation.policies import PolicyParams, make_policy
+from sim.navigation.replanner import ReplanParams
+from sim.navigation.targeting import TargetParams
+from sim.perception import GeometricParams, Sighting, make_perception
+from sim.perception.laser import LaserParams, laser_angles, scan
+from sim.world.data import World, load_world
+from sim.world.robot import Robot, RobotParams
+from sim.world.scene import build_scene
+
+
+@dataclass(frozen=True)
+class TrialParams:
+    """Rates, caps and the per-trial variation a seed draws."""
+
+    control_hz: float = 10.0  # Hz of simulated time: planning, following, stuck checks
+    mapping_hz: float = 5.0  # Hz, laser scans into the occupancy grid
+    perception_hz: float = 4.0  # Hz, camera sweeps (or geometric checks)
+    max_sim_s: float = 900.0  # s of simulated time before the trial fails
+    max_distance_m: float = 300.0  # m travelled before the trial fails
+    start_jitter_m: float = 0.0  # m, std of the start position's Gaussian jitter
+    start_jitter_deg: float = 0.0  # deg, std of the start heading's jitter
+    odometry_noise_m: float = 0.0  # m per sqrt(m travelled), odometry drift (RobotParams); 0 = perfect
+    detection_noise_m: float = 0.0  # m, std added to each sighting's position (geometric mode)
+    detection_noise_deg: float = 0.0  # deg, std added to each sighting's facing (geometric mode)
+    trajectory_hz: float = 2.0  # Hz of the recorded trajectory
+    record_every_s: float = 2.0  # s of simulated time between animation frames (with record=True)
+    navigator: NavigatorParams = field(default_factory=NavigatorParams)
+    # An imagined goal beyond a wall leads to the nearest reachable cell within 10 m of it.
+    planner: PlannerParams = field(default_factory=lambda: PlannerParams(goal_snap_radius_m=10.0))
+    replan: ReplanParams = field(default_factory=ReplanParams)
+    follower: FollowerParams = field(default_factory=FollowerParams)
+    targeting: TargetParams = field(default_factory=TargetParams)
+    target_recheck_s: float = 5.0  # s between re-choosing the target when the model has not changed
+    laser: LaserParams = field(default_factory=LaserParams)
+    occupancy_resolution_m: float = 0.1  # m, grid cell
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A snapshot for the animation."""
+
+    t_s: float
+    pose: tuple[float, float, float]
+    grid: np.ndarray  # to_image() of the occupancy grid
+    places: dict[str, tuple[float, float]]
+    target: tuple[float, float]
+    path: np.ndarray | None
+
+
+@dataclass
+class TrialResult:
+    """What a trial did, in the form written to result.json."""
+
+    world: str
+    goal: str
+    seed: int
+    perception: str
+    success: bool
+    reason: str
+    distance_m: float
+    sim_s: float
+    wall_s: float
+    start: tuple[float, float, float]
+    cues: list[CueEvent]
+    trajectory: np.ndarray  # (N, 4): t s, x m, y m, theta rad (true pose)
+    final_positions: dict[str, tuple[float, float]]
+    exploration_bumps: int
+    settle_median_ms: float
+    frames: list[Frame] = field(default_factory=list, repr=False)
+    grid_extent: tuple[float, float, float, float] | None = None
+
+    @property
+    def realtime_factor(self) -> float:
+        """Simulated seconds per wall second."""
+        return self.sim_s / self.wall_s if self.wall_s > 0 else math.inf
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "world": self.world, "goal": self.goal, "seed": self.seed, "perception": self.perception,
+            "success": self.success, "reason": self.reason, "distance_m": round(self.distance_m, 3),
+            "sim_s": round(self.sim_s, 2), "wall_s": round(self.wall_s, 2),
+            "realtime_factor": round(self.realtime_factor, 2), "start": list(self.start),
+            "cues": [asdict(c) for c in self.cues],
+            "exploration_bumps": self.exploration_bumps, "settle_median_ms": round(self.settle_median_ms, 2),
+            "final_positions": {k: [round(v[0], 3), round(v[1], 3)] for k, v in self.final_positions.items()},
+            "trajectory": [[round(float(v), 3) for v in row] for row in self.trajectory],
+        }
+
+
+Progress = Callable[[float, float, int], None]
+"""Called about once per simulated second with (sim time s, distance m, cues read)."""
+
+
+def _start_pose(world: World, params: TrialParams, rng: np.random.Generator) -> tuple[float, float, float]:
+    x, y, theta = world.start
+    return (x + rng.normal(0.0, params.start_jitter_m) if params.start_jitter_m else x,
+            y + rng.normal(0.0, params.start_jitter_m) if params.start_jitter_m else y,
+            theta + math.radians(rng.normal(0.0, params.start_jitter_deg)) if params.start_jitter_deg else theta)
+
+
+Observer = Callable[["Trial"], None]
+"""Called after every control tick with the trial (for recordings); must not change it."""
+
+
+class Trial:
+    """One closed-loop trial, stepped one control tick at a time.
+
+    Construction builds the world, puts the robot at the (jittered) start and
+    takes the first look (laser and tags at t = 0). Each :meth:`step` drives
+    for one tick with the given ``(v, w)`` command (m/s, rad/s; the robot's
+    limits apply) or, without one, with the navigator's own command, then
+    senses at the rates in :class:`TrialParams`. :attr:`done` turns true when
+    the goal's label is read, a cap is hit or exploration is exhausted, with
+    :attr:`reason` saying which. Always :meth:`close` it (or use ``with``).
+    """
+
+    def __init__(self, world: World | str, goal: str, *, seed: int = 0, perception: str = "camera",
+                 navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
+                 record: bool = False) -> None:
+        self.began = time.perf_counter()
+        self.world = load_world(world) if isinstance(world, str) else world
+        self.params = params = params or TrialParams()
+        if goal not in self.world.goals and not self.world.label_tags(goal):
+            raise ValueError(f"goal {goal!r}: no label in world {self.world.name!r}; "
+                             f"study goals: {sorted(self.world.goals)}")
+        self.goal, self.seed, self.mode = goal, seed, perception
+        self.progress, self.record = progress, record
+        self.observers: list[Observer] = []
+        self.rng = rng = np.random.default_rng(seed)
+        self.start = _start_pose(self.world, params, rng)
+        self.scene = scene = build_scene(self.world)
+        try:
+            self.robot = Robot(scene, params=RobotParams(odometry_noise_m=params.odometry_noise_m), rng=rng)
+            self.robot.reset(*self.start)
+            self.sensor = make_perception(perception, scene, rng=rng, **_perception_kwargs(perception, params))
+        except BaseException:
+            scene.close()
+            raise
+        x0, x1, y0, y1 = self.world.floorplan.extent
+        self.grid = OccupancyGrid(OccupancyParams(resolution_m=params.occupancy_resolution_m, bounds=(x0, x1, y0, y1)))
+        self.angles = laser_angles(params.laser)
+        self.navigator = navigator
+        self.policy = make_policy(navigator, self.world, goal, self.start, PolicyParams(
+            params.navigator, params.planner, params.replan, params.follower, params.targeting,
+            params.target_recheck_s))
+        self.goal_tags = {tag.id for tag in self.world.tags.values()
+                          if tag.kind == "label" and tag.text.casefold() == goal.casefold()}
+        self.success = False
+        self.steps_per_tick = max(1, round(1.0 / params.control_hz / scene.time_step))
+        self.tick = self.steps_per_tick * scene.time_step  # s of simulated time per step
+        self.every = {name: max(1, round(params.control_hz / hz)) for name, hz in
+                      (("map", params.mapping_hz), ("see", params.perception_hz), ("traj", params.trajectory_hz))}
+        self.frame_every = max(1, round(params.record_every_s / self.tick))
+        self.t, self.distance, self.n = 0.0, 0.0, 0
+        self.last = self.robot.true_pose()
+        self.trajectory: list[tuple[float, float, float, float]] = [(0.0, *self.last)]
+        self.frames: list[Frame] = []
+        self.reason = ""
+        self.scan: np.ndarray | None = None  # m, the latest laser ranges
+        self.sightings: list[Sighting] = []  # the tags read at the latest look
+        self._sense()
+
+    @property
+    def done(self) -> bool:
+        return bool(self.reason)
+
+    def __enter__(self) -> Trial:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        self.scene.close()
+
+    def _cast(self, origins: np.ndarray, ends: np.ndarray) -> np.ndarray:
+        z = np.full((len(origins), 1), self.params.laser.height_m)
+        return self.scene.ray_fractions(np.hstack([origins, z]), np.hstack([ends, z]))
+
+    def _sense(self) -> None:
+        """Laser and tags at their rates, then the success and cap checks."""
+        params, pose = self.params, self.robot.pose()
+        self.sightings = []
+        if self.n % self.every["map"] == 0:
+            self.scan = scan(pose, self._cast, params.laser, self.rng)
+            self.grid.integrate(pose, self.angles, self.scan, params.laser.max_range_m)
+        if self.n % self.every["see"] == 0:
+            self.sightings = self.sensor.observe(self.robot)
+            self.policy.observe(self.sightings, t_s=self.t, distance_m=self.distance, grid=self.grid)
+            if any(s.tag_id in self.goal_tags for s in self.sightings):
+                self.success = True
+                self.reason = "goal label read"
+                return
+        if self.t >= params.max_sim_s:
+            self.reason = f"simulated time cap of {params.max_sim_s:.0f} s reached"
+        elif self.distance >= params.max_distance_m:
+            self.reason = f"distance cap of {params.max_distance_m:.0f} m reached"
+
+    def command(self) -> tuple[float, float]:
+        """The navigator's own (v, w) for this tick (m/s, rad/s); may end the trial (the navigator gave up)."""
+        v, w = self.policy.command(self.t, self.robot.pose(), self.grid, self.tick, self.rng)
+        if self.policy.gave_up:
+            self.reason = self.policy.gave_up
+        return v, w
+
+    def step(self, command: tuple[float, float] | None = None) -> bool:
+        """Drive one tick with ``command`` (m/s, rad/s) or the navigator's own; sense. True when done."""
+        if self.done:
+            raise RuntimeError(f"trial already ended: {self.reason}")
+        v, w = self.command() if command is None else command
+        if self.done:
+            return True
+        self.robot.command(v, w)
+        self.scene.step(self.steps_per_tick)
+        self.t += self.tick
+        self.n += 1
+        now = self.robot.true_pose()
+        self.distance += math.hypot(now[0] - self.last[0], now[1] - self.last[1])
+        self.last = now
+        if self.n % self.every["traj"] == 0:
+            self.trajectory.append((self.t, *now))
+        if self.progress and self.n % round(1.0 / self.tick) == 0:
+            self.progress(self.t, self.distance, len(self.policy.cues))
+        if self.record and self.n % self.frame_every == 0:
+            self.frames.append(self.snapshot(now))
+        self._sense()
+        for observer in self.observers:
+            observer(self)
+        return self.done
+
+    def snapshot(self, pose: tuple[float, float, float]) -> Frame:
+        """An animation frame of the trial now."""
+        places, target, path = self.policy.picture()
+        return Frame(self.t, pose, self.grid.to_image(), places, target, path)
+
+    def result(self) -> TrialResult:
+        """What the trial did so far, as written to result.json."""
+        final = self.robot.true_pose()
+        trajectory = [*self.trajectory, (self.t, *final)]
+        frames = [*self.frames, self.snapshot(final)] if self.record else []
+        if self.progress:
+            self.progress(self.t, self.distance, len(self.policy.cues))
+        settle_ms = self.policy.settle_ms()
+        return TrialResult(
+            world=self.world.name, goal=self.goal, seed=self.seed, perception=self.mode, success=self.success,
+            reason=self.reason, distance_m=self.distance, sim_s=self.t, wall_s=time.perf_counter() - self.began,
+            start=self.start, cues=self.policy.cues, trajectory=np.array(trajectory),
+            final_positions=self.policy.picture()[0], exploration_bumps=getattr(self.policy, "bumps", 0),
+            settle_median_ms=float(np.median(settle_ms)) if settle_ms else 0.0, frames=frames,
+            grid_extent=self.grid.extent,
+        )
+
+
+def run_trial(world: World | str, goal: str, *, seed: int = 0, perception: str = "camera",
+              navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
+              record: bool = False) -> TrialResult:
+    """Run one trial of finding ``goal`` in ``world`` with the navigator driving, and report what happened."""
+    with Trial(world, goal, seed=seed, perception=perception, navigator=navigator, params=params,
+               progress=progress, record=record) as trial:
+        while not trial.done:
+            trial.step()
+        return trial.result()
+
+
+def _perception_kwargs(mode: str, params: TrialParams) -> dict[str, Any]:
+    """Detection noise is added in geometric mode; the camera's noise is its detector's own."""
+    if mode == "geometric":
+        return {"params": GeometricParams(noise_m=params.detection_noise_m,
+                                          noise_rad=math.radians(params.detection_noise_deg))}
+    return {}

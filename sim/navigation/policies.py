@@ -1,0 +1,162 @@
+"""Navigation policies: how the robot decides each tick, by name (``--navigator``).
+
+A policy sees what the robot sensed (tag sightings, the occupancy grid, its
+pose) and answers with a wheel command ``(v, w)`` (m/s, rad/s). Every policy
+shares the same drive stack (re-planner, path follower, stuck recovery); what
+differs is where it wants to go. Register a new one in :data:`NAVIGATORS`.
+
+- ``paper``: the paper's robot: drive to the goal's imagined position in the
+  abstract map (or a stand-in target when that lies behind walls), grow the
+  model when the goal is not there.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from abstract_map.model import imagined_positions
+from sim.mapping.occupancy import OccupancyGrid
+from sim.navigation.follower import FollowerParams, PathFollower, Recovery, RecoveryParams, StuckDetector, StuckParams
+from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
+from sim.navigation.planner import Plan, PlannerParams
+from sim.navigation.replanner import Replanner, ReplanParams
+from sim.navigation.targeting import Target, TargetParams, choose_target
+from sim.perception.sighting import Sighting
+from sim.world.data import World
+
+Pose = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class PolicyParams:
+    """What every policy is built from (one slice of the trial's parameters)."""
+
+    navigator: NavigatorParams
+    planner: PlannerParams
+    replan: ReplanParams
+    follower: FollowerParams
+    targeting: TargetParams
+    target_recheck_s: float  # s between re-choosing the target when nothing new was read
+
+
+class Policy(Protocol):
+    """What the trial asks of a navigation policy."""
+
+    cues: list[CueEvent]  # tags read for the first time, in order
+    gave_up: str  # why the policy stopped (non-empty ends the trial)
+
+    def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
+                grid: OccupancyGrid) -> None:
+        """Take in the tags read now."""
+
+    def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
+                rng: np.random.Generator) -> tuple[float, float]:
+        """The wheel command for the next tick (m/s, rad/s)."""
+
+    def picture(self) -> tuple[dict[str, tuple[float, float]], tuple[float, float], np.ndarray | None]:
+        """For drawing: imagined places (m, may be empty), the current target (m) and planned path (N, 2 m)."""
+
+    def settle_ms(self) -> list[float]:
+        """Wall time (ms) of each settle of the policy's model after the first (empty: no model)."""
+
+
+class DriveStack:
+    """Re-planning, path following and stuck recovery towards a target: the part every policy shares."""
+
+    def __init__(self, params: PolicyParams) -> None:
+        self.replanner = Replanner(params.replan, params.planner)
+        self.follower = PathFollower(params.follower)
+        self.stuck, self.recovery = StuckDetector(StuckParams()), Recovery(RecoveryParams())
+
+    @property
+    def plan(self) -> Plan | None:
+        return self.replanner.plan
+
+    def drive(self, t_s: float, pose: Pose, grid: OccupancyGrid, target_xy: np.ndarray, tick_s: float,
+              arrive_m: float, rng: np.random.Generator) -> tuple[float, float, bool]:
+        """``(v, w, arrived)``: the command towards ``target_xy``; arrived when within ``arrive_m`` of the plan's end
+        or no plan exists (the target cannot be reached)."""
+        if self.recovery.active:
+            step = self.recovery.step(t_s)
+            if step.replan:
+                self.replanner.request()
+                self.stuck.reset()
+            return step.v, step.w, False
+        plan = self.replanner.update(t_s, grid, pose[:2], target_xy)
+        if plan is None:
+            return 0.0, 0.0, True
+        v, w, done = self.follower.command(pose, plan.waypoints, tick_s)
+        arrived = done and float(np.hypot(*(np.array(plan.goal_xy) - pose[:2]))) < arrive_m
+        if self.stuck.update(t_s, pose, commanded=abs(v) > 0.01 or abs(w) > 0.01):
+            self.recovery.start(t_s, turn_sign=1.0 if rng.random() < 0.5 else -1.0)
+        return v, w, arrived
+
+
+class PaperPolicy:
+    """The paper's robot: to the goal's imagined position, growing the model when it is not there."""
+
+    def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
+        self.params = params
+        self.nav = Navigator.start(world, goal, start, params=params.navigator)
+        self.drive = DriveStack(params)
+        self.target: Target | None = None
+        self.target_at = -float("inf")
+        self.bumps = 0  # exploration bumps in all
+        self.gave_up = ""
+
+    @property
+    def cues(self) -> list[CueEvent]:
+        return self.nav.cues
+
+    def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
+                grid: OccupancyGrid) -> None:
+        if self.nav.observe(sightings, t_s=t_s, distance_m=distance_m, explored_centre=grid.explored_centre):
+            self.target = None
+
+    def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
+                rng: np.random.Generator) -> tuple[float, float]:
+        params = self.params
+        # A stand-in target is kept until the model changes; the imagined goal is re-checked as the map grows.
+        if self.target is None or (not self.target.local and t_s - self.target_at >= params.target_recheck_s):
+            detours = self.nav.bumps_in_a_row >= params.targeting.local_bumps
+            robot_xy = np.array(pose[:2])
+            self.target = choose_target(grid, robot_xy, self.nav.target(robot_xy), params.planner,
+                                        params.targeting, allow_detours=detours)
+            self.target_at = t_s
+        v, w, arrived = self.drive.drive(t_s, pose, grid, self.target.xy, tick_s, self.nav.params.arrive_m, rng)
+        if arrived:
+            if not self.nav.arrived_without_goal(grid.explored_centre()):
+                self.gave_up = "exploration exhausted: the goal was not found where imagined"
+                return 0.0, 0.0
+            self.bumps += 1
+            self.target = None
+            self.drive.replanner.request()
+        return v, w
+
+    def picture(self) -> tuple[dict[str, tuple[float, float]], tuple[float, float], np.ndarray | None]:
+        shown = self.nav.target() if self.target is None else self.target.xy
+        plan = self.drive.plan
+        return dict(imagined_positions(self.nav.model)), tuple(shown), None if plan is None else plan.waypoints
+
+    def settle_ms(self) -> list[float]:
+        settles = self.nav.settles
+        return [s.wall_s * 1000 for s in settles[1:]] or [settles[0].wall_s * 1000]
+
+
+NAVIGATORS: dict[str, type] = {
+    "paper": PaperPolicy,
+}
+"""Every navigation policy by its ``--navigator`` name; each is built as ``cls(world, goal, start, params)``."""
+
+
+def make_policy(name: str, world: World, goal: str, start: Pose, params: PolicyParams) -> Policy:
+    """The navigation policy ``name``; a ValueError lists the known ones."""
+    try:
+        cls = NAVIGATORS[name]
+    except KeyError:
+        raise ValueError(f"unknown navigator {name!r}; known navigators: {sorted(NAVIGATORS)}") from None
+    return cls(world, goal, start, params)
