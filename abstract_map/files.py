@@ -8,7 +8,9 @@ disk, a killed process) leaves the previous file intact, never a truncated one.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import os
+import re
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
@@ -50,3 +52,19 @@ def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> None:
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> None:
     """Write ``text`` (UTF-8) to ``path`` atomically."""
     write_bytes_atomic(path, text.encode("utf-8"))
+
+
+_PLAIN = re.compile(r"[A-Za-z0-9]+(?: [A-Za-z0-9]+)*")
+
+
+def safe_name(text: str) -> str:
+    """A file name for ``text`` (e.g. a goal) that is safe on every system and unique per text.
+
+    Words of letters and digits keep their spelling with spaces as underscores ("Polar bear" ->
+    "Polar_bear"); any other text becomes a slug plus a hash of its exact spelling ("Polar_bear" ->
+    "Polar_bear~1c5e...", "../../x" -> "x~..."), which no plain name can equal (it has a '~').
+    """
+    if _PLAIN.fullmatch(text) and len(text) <= 60:
+        return text.replace(" ", "_")
+    slug = re.sub(r"[^A-Za-z0-9]+", "_", text).strip("_")[:40] or "name"
+    return f"{slug}~{hashlib.sha256(text.encode('utf-8', 'surrogatepass')).hexdigest()[:12]}"

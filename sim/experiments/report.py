@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from abstract_map.files import atomic_path, safe_name
 from sim.experiments.pictures import draw_floorplan, draw_path, draw_tags
 from sim.world.data import World
 from sim.world.oracle import OraclePath
@@ -140,7 +141,8 @@ def comparison_plot(rows: list[GoalRow], path: str | os.PathLike[str]) -> None:
     ax.legend(loc="lower right")
     ax.set_title("Finding goals in the zoo: humans, the paper's robot, ours")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=120)
     plt.close(fig)
 
 
@@ -174,8 +176,9 @@ def path_pictures(world: World, records: list[dict[str, Any]], oracles: dict[str
         ax.set_title(f"{world.title}: paths to the {goal}")
         ax.legend(loc="lower right", fontsize=7)
         fig.tight_layout()
-        path = folder / f"{goal.replace(' ', '_')}.png"
-        fig.savefig(path, dpi=100)
+        path = folder / f"{safe_name(goal)}.png"
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=100)
         plt.close(fig)
         written.append(path)
     return written

@@ -13,14 +13,15 @@ from __future__ import annotations
 
 import csv
 import json
-import os
 import time
 import traceback
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from abstract_map.errors import AbstractMapError
+from abstract_map.files import atomic_path, safe_name, write_text_atomic
 from sim.experiments.trial import TrialParams
 from sim.world.data import World
 
@@ -39,7 +40,8 @@ class TrialSpec:
 
     @property
     def key(self) -> str:
-        return f"{self.goal.replace(' ', '_')}-{self.seed}"
+        """The trial's file name stem: safe, and unique per (goal, seed)."""
+        return f"{safe_name(self.goal)}-{self.seed}"
 
 
 def study_params(perception: str, base: TrialParams | None = None) -> TrialParams:
@@ -60,7 +62,7 @@ def run_spec(spec: TrialSpec) -> dict[str, Any]:
         return result.to_dict()
     except Exception as exc:  # a failed trial is data, not a crash of the study
         return {"goal": spec.goal, "seed": spec.seed, "perception": spec.perception, "success": False,
-                "reason": f"error: {type(exc).__name__}: {exc}", "distance_m": float("nan"), "sim_s": 0.0,
+                "reason": f"error: {type(exc).__name__}: {exc}", "distance_m": None, "sim_s": 0.0,
                 "wall_s": round(time.perf_counter() - began, 2), "traceback": traceback.format_exc()}
 
 
@@ -125,37 +127,91 @@ def plan_specs(world: World, trials: int, perception: str, *, base: TrialParams 
                goals: Iterable[str] | None = None) -> list[TrialSpec]:
     """Every goal x ``trials`` seeds, goals in the world's order."""
     params = study_params(perception, base)
-    chosen = list(goals) if goals is not None else list(world.goals)
+    chosen = list(dict.fromkeys(goals)) if goals is not None else list(world.goals)
     return [TrialSpec(str(world.root), goal, seed, perception, params) for goal in chosen for seed in range(trials)]
 
 
-def _write_atomic(path: Path, text: str) -> None:
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+class StudyError(AbstractMapError):
+    """A study folder that cannot be resumed with these settings."""
+
+
+SETTINGS_FILE = "study-settings.json"
+"""The settings a study folder's trials were run with; a resume must ask for the same."""
+
+
+def study_settings(world: World, specs: list[TrialSpec]) -> dict[str, Any]:
+    """What every trial record in a study folder depends on (not the trial count, goals or workers)."""
+    params = sorted({json.dumps(asdict(s.params), sort_keys=True) for s in specs})
+    return json.loads(json.dumps({"world": world.name, "perception": sorted({s.perception for s in specs}),
+                                  "params": [json.loads(p) for p in params]}))
+
+
+def check_settings(out: Path, settings: dict[str, Any]) -> None:
+    """Record ``settings`` in a new study folder, or refuse a folder made with other settings."""
+    path = out / SETTINGS_FILE
+    if path.exists():
+        try:
+            recorded = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            raise StudyError(f"{path}: unreadable ({exc}); remove it only if every trial in {out} "
+                             "was run with the settings asked for now") from None
+        if recorded != settings:
+            differ = [k for k in sorted(set(recorded) | set(settings)) if recorded.get(k) != settings.get(k)]
+            shown = {k: recorded.get(k) for k in differ if k != "params"}
+            raise StudyError(f"{out} holds a study run with other settings ({', '.join(differ)}: "
+                             f"{shown or 'trial parameters'}); resume it with those, or use another --out")
+        return
+    if (out / "trials").is_dir() and any((out / "trials").glob("*.json")):
+        raise StudyError(f"{out}: trials without {SETTINGS_FILE} (from an older version?); use another --out")
+    write_text_atomic(path, json.dumps(settings, indent=1, sort_keys=True))
+
+
+def load_record(path: Path, spec: TrialSpec) -> dict[str, Any] | None:
+    """The finished trial recorded at ``path`` for ``spec``, or None if missing, corrupt or another trial's."""
+    try:
+        record = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return None
+    if not isinstance(record, dict) or any(record.get(k) != getattr(spec, k) for k in ("goal", "seed", "perception")):
+        return None
+    if not isinstance(record.get("success"), bool) or "reason" not in record:
+        return None
+    return record
 
 
 def run_study(world: World, specs: list[TrialSpec], out: Path, *, executor: ProcessExecutor | RayExecutor,
               progress: Callable[[int, int, dict[str, Any] | None], None] | None = None) -> list[dict[str, Any]]:
-    """Run the specs not yet done in ``out/trials``; return every trial's record (done before or now)."""
+    """Run the specs not yet done in ``out/trials``; return every trial's record (done before or now).
+
+    A record that is missing, corrupt or not the spec's own is (re-)run; a folder made with other
+    settings (:func:`study_settings`) raises :class:`StudyError` before anything runs.
+    """
+    specs = list({s.key: s for s in specs}.values())
+    check_settings(out, study_settings(world, specs))
     folder = out / "trials"
     folder.mkdir(parents=True, exist_ok=True)
-    todo = [s for s in specs if not (folder / f"{s.key}.json").exists()]
+    records: dict[str, dict[str, Any]] = {}
+    for spec in specs:
+        record = load_record(folder / f"{spec.key}.json", spec)
+        if record is not None:
+            records[spec.key] = record
+    todo = [s for s in specs if s.key not in records]
     done = len(specs) - len(todo)
     if progress:
         progress(done, len(specs), None)
     for spec, record in executor.map_unordered(run_spec, todo):
-        _write_atomic(folder / f"{spec.key}.json", json.dumps(record))
+        write_text_atomic(folder / f"{spec.key}.json", json.dumps(record))
+        records[spec.key] = record
         done += 1
         if progress:
             progress(done, len(specs), record)
-    records = [json.loads((folder / f"{s.key}.json").read_text()) for s in specs]
-    write_csv(records, out / "trials.csv")
-    return records
+    ordered = [records[s.key] for s in specs]
+    write_csv(ordered, out / "trials.csv")
+    return ordered
 
 
 def write_csv(records: list[dict[str, Any]], path: Path) -> None:
-    with path.open("w", newline="") as handle:
+    with atomic_path(path) as tmp, tmp.open("w", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=CSV_FIELDS, extrasaction="ignore")
         writer.writeheader()
         for record in sorted(records, key=lambda r: (r["goal"], r["seed"])):

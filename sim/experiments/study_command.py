@@ -16,13 +16,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import shutil
 import sys
 import time
 from pathlib import Path
 from typing import Any
 
-from abstract_map.cli import ExitError
+from abstract_map.cli import ExitError, output_folder
+from abstract_map.errors import integer
+from abstract_map.files import write_bytes_atomic, write_text_atomic
 
 SUMMARY = "run every goal of a world N times and compare with the paper (needs [sim])"
 EXTRA = "sim"  # the optional dependencies it needs
@@ -45,18 +46,21 @@ def run(args: argparse.Namespace) -> int:
 
     from sim.experiments.report import comparison_plot, goal_rows, path_pictures, report_markdown
     from sim.experiments.study import make_executor, plan_specs, run_study
-    from sim.world.data import WorldError, load_world
+    from sim.world.data import load_world
     from sim.world.oracle import oracle_path
 
-    if args.trials < 1 or args.workers < 1:
-        raise ExitError("--trials and --workers must be at least 1")
+    integer("--trials", args.trials, low=1, high=10_001, error=ExitError)
+    integer("--workers", args.workers, low=1, high=257, error=ExitError)
+    output_folder("--out", args.out)
+    if args.goals is not None and len(set(args.goals)) < len(args.goals):
+        raise ExitError(f"--goals: a goal is named twice in {args.goals}")
+    world = load_world(args.world)
+    unknown = [g for g in (args.goals or []) if g not in world.goals]
+    if unknown:
+        raise ExitError(f"--goals: unknown goal(s) {unknown}; goals of {world.name}: {sorted(world.goals)}")
     try:
-        world = load_world(args.world)
-        unknown = [g for g in (args.goals or []) if g not in world.goals]
-        if unknown:
-            raise ExitError(f"unknown goal(s) {unknown}; goals of {world.name}: {sorted(world.goals)}")
         executor = make_executor(args.executor, args.workers, args.address)
-    except (WorldError, ValueError) as exc:
+    except ValueError as exc:
         raise ExitError(str(exc)) from exc
     specs = plan_specs(world, args.trials, args.perception, goals=args.goals)
     began = time.perf_counter()
@@ -74,16 +78,16 @@ def run(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - began
     oracles = {goal: oracle_path(world, goal) for goal in dict.fromkeys(s.goal for s in specs)}
     rows = goal_rows(world, records, oracles)
-    (args.out / "report.md").write_text(report_markdown(world, rows, perception=args.perception,
-                                                        trials=args.trials, wall_s=wall))
+    write_text_atomic(args.out / "report.md", report_markdown(world, rows, perception=args.perception,
+                                                              trials=args.trials, wall_s=wall))
     comparison_plot(rows, args.out / "comparison.png")
     path_pictures(world, records, oracles, args.out / "paths")
-    (args.out / "study.json").write_text(json.dumps({"world": world.name, "trials": args.trials,
+    write_text_atomic(args.out / "study.json", json.dumps({"world": world.name, "trials": args.trials,
                                                      "perception": args.perception, "workers": args.workers,
                                                      "executor": args.executor, "wall_s": round(wall, 1)}))
     reference = world.root / "paper_trials.csv"
     if reference.exists():
-        shutil.copyfile(reference, args.out / "paper_trials.csv")
+        write_bytes_atomic(args.out / "paper_trials.csv", reference.read_bytes())
     print((args.out / "report.md").read_text(), file=sys.stderr)
     failed = sum(1 for r in records if not r["success"])
     print(f"{len(records) - failed}/{len(records)} trials found their goal; wrote {args.out}/", file=sys.stderr)
