@@ -35,6 +35,7 @@ class Hierarchy:
 
     def __post_init__(self) -> None:
         self._known = set(self.places)
+        self._with_children = set(self.parent.values())
         if len(self._known) != len(self.places):
             raise HierarchyError("hierarchy: a place is listed twice")
 
@@ -51,7 +52,7 @@ class Hierarchy:
             return False
         if child in self.parent:
             raise HierarchyError(f"{where}: {child!r} is already in {self.parent[child]!r}, not also in {parent!r}")
-        if child in self._known:  # a new child has no descendants, so it cannot close a cycle
+        if child in self._with_children:  # a place with no children cannot be an ancestor of its parent
             node: str | None = parent
             while node is not None:
                 if node == child:
@@ -60,6 +61,7 @@ class Hierarchy:
         for name in (child, parent):
             self.add_place(name)
         self.parent[child] = parent
+        self._with_children.add(parent)
         return True
 
     def add_place(self, name: str, *, where: str = "hierarchy") -> None:
