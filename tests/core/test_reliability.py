@@ -188,7 +188,7 @@ def test_issue9_item8_unanchored_places_stay_near():
 
 @pytest.mark.parametrize("text, limit_s", [
     ("$LEFT$ " + ", ".join(f"P{i}" for i in range(1_000)), 20.0),  # took 35 s (and 120 s freeing pymunk's space)
-    ("\n".join(f"P{i + 1} is past P{i}" for i in range(300)), 30.0),  # took 40 s (5,000 steps: its springs stretch it for km)
+    ("\n".join(f"P{i + 1} is past P{i}" for i in range(300)), 30.0),  # took 40 s (5,000 steps: it stretches for km)
 ])
 def test_issue9_item8_large_cues_cost_near_linear_time(text, limit_s):
     model = zoo_map()
