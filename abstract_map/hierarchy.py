@@ -71,7 +71,7 @@ class Hierarchy:
             self.places.append(name)
 
     def __contains__(self, name: object) -> bool:
-        return name in self._known
+        return isinstance(name, str) and name in self._known
 
     def children(self, name: str) -> list[str]:
         return [c for c in self.places if self.parent.get(c) == name]

@@ -179,11 +179,11 @@ def from_dict(data: Any, *, where: str = "model") -> AbstractMap:
     try:
         hierarchy = Hierarchy()
         for name in _list(f"{where} hierarchy places", spec["places"]):
-            if name in hierarchy:
+            if _name(f"{where} hierarchy places", name) in hierarchy:
                 raise ModelFileError(f"{where} hierarchy places: {errors.show(name)} is listed twice")
             hierarchy.add_place(_name(f"{where} hierarchy places", name), where=f"{where} hierarchy")
         for pair in _list(f"{where} hierarchy parent", spec["parent"]):
-            child, parent = _list(f"{where} hierarchy parent", pair, 2)
+            child, parent = (_name(f"{where} hierarchy parent", n) for n in _list(f"{where} hierarchy parent", pair, 2))
             if child not in hierarchy or parent not in hierarchy:
                 raise ModelFileError(f"{where} hierarchy parent: {errors.show(pair)} names a place not listed")
             hierarchy.add(child, parent, where=f"{where} hierarchy")
