@@ -344,8 +344,8 @@ def load_world(name_or_path: str | os.PathLike[str]) -> World:
             if not _inside(floorplan, tag.x, tag.y, margin=1.0):
                 problems.add(f"tag {tag.id}: ({tag.x}, {tag.y}) is off the floor plan")
     goals = problems.guard(lambda: _goals(meta["goals"], tags, hierarchy))
-    if hierarchy is not None and tags is not None and start is not None:
-        _read_tags(hierarchy, start, tags, problems)
+    if hierarchy is not None and tags is not None:  # the start only anchors the model: any will do
+        _read_tags(hierarchy, start or (0.0, 0.0, 0.0), tags, problems)
     tag_spec = problems.guard(lambda: _optional(meta, "tag", {"size_m": (0.25, 0.01, 2.0),
                                                                "height_m": (1.1, 0.0, 10.0)}))
     walls = problems.guard(lambda: _optional(meta, "walls", {"height_m": (2.0, 0.05, 100.0)}))
