@@ -16,6 +16,7 @@ from collections.abc import Sequence
 from importlib.metadata import entry_points
 from pathlib import Path
 from types import ModuleType
+from typing import NoReturn
 
 from .errors import AbstractMapError, one_line
 
@@ -97,8 +98,15 @@ def _missing_message(name: str, extra: str | None, exc: ModuleNotFoundError) -> 
     return f"abstract-map {name}: needs the package {exc.name!r}, which is not installed{hint}"
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (no usage block), exit code 2."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, one_line(f"{self.prog}: {message}") + "\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="abstract-map",
         description="Navigate unseen buildings from human signs and labels (Talbot et al. 2020).",
     )

@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from sim.experiments.report import comparison_plot, goal_rows, path_pictures, report_markdown
-    from sim.experiments.study import make_executor, plan_specs, run_study
+    from sim.experiments.study import check_settings, make_executor, plan_specs, run_study, study_settings
     from sim.world.data import load_world
     from sim.world.oracle import oracle_path
 
@@ -63,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:
         raise ExitError(str(exc)) from exc
     specs = plan_specs(world, args.trials, args.perception, goals=args.goals)
+    check_settings(args.out, study_settings(world, specs))  # a resume with other settings stops here
     began = time.perf_counter()
     bar = tqdm(total=len(specs), unit="trial", file=sys.stderr, dynamic_ncols=True)
 
