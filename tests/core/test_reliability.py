@@ -187,13 +187,18 @@ def test_issue9_item8_unanchored_places_stay_near():
 
 
 @pytest.mark.parametrize("text, limit_s", [
-    ("$LEFT$ " + ", ".join(f"P{i}" for i in range(1_000)), 20.0),  # took 35 s (and 120 s freeing pymunk's space)
-    ("\n".join(f"P{i + 1} is past P{i}" for i in range(300)), 30.0),  # took 40 s (5,000 steps: it stretches for km)
+    ("$LEFT$ " + ", ".join(f"P{i}" for i in range(1_000)), 15.0),  # took 35 s (and 120 s freeing pymunk's space)
+    # a settle capped at 1,000 steps (the chain stretches for km under the expansion force, so it uses them
+    # all): 9 s when each step's forces cost O(masses x springs), 1 s now
+    ("\n".join(f"P{i + 1} is past P{i}" for i in range(300)), 5.0),
 ])
 def test_issue9_item8_large_cues_cost_near_linear_time(text, limit_s):
+    from abstract_map.params import AbstractMapParams, DynamicsParams
+
     model = zoo_map()
-    began = time.perf_counter()
+    model.params = AbstractMapParams(dynamics=DynamicsParams(max_iterations=1_000))
+    began = time.process_time()  # CPU seconds of this process: other work on the machine does not count
     model.observe_tag(7, text, (0.0, 5.0, -math.pi / 2))
     model.settle()
-    assert time.perf_counter() - began < limit_s
+    assert time.process_time() - began < limit_s
     assert all(np.all(np.isfinite(xy)) for xy in model.positions.values())

@@ -29,7 +29,8 @@ class FakeExecutor:
 
 def fake_run(spec: TrialSpec) -> dict:
     return {"goal": spec.goal, "seed": spec.seed, "perception": spec.perception, "success": True,
-            "reason": "found", "distance_m": 10.0 + spec.seed, "sim_s": 5.0, "wall_s": 0.1, "trajectory": [[0.0, 2.0, 2.0], [1.0, 2.5, 2.0]]}
+            "reason": "found", "distance_m": 10.0 + spec.seed, "sim_s": 5.0, "wall_s": 0.1,
+            "trajectory": [[0.0, 2.0, 2.0], [1.0, 2.5, 2.0]]}
 
 
 def test_issue9_item5_a_resume_with_other_settings_is_refused(tiny_world, tmp_path):
