@@ -73,8 +73,11 @@ def one_line(text: str, limit: int = 400) -> str:
 def show(value: Any, limit: int = 60) -> str:
     """A short ``repr`` of an input value for an error message."""
     if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 10**30:
-        return f"an integer of {len(str(abs(value)))} digits"
-    text = repr(value)
+        return f"an integer of about {int(value.bit_length() * math.log10(2)) + 1} digits"
+    try:
+        text = repr(value)
+    except (RecursionError, ValueError):  # a deeply nested container; an object whose repr fails
+        return f"a {type(value).__name__}"
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 

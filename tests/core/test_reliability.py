@@ -97,7 +97,7 @@ def saved(tmp_path, change) -> str:
     (lambda d: d["positions"].update(Lion=[math.inf, 0.0]), "positions Lion x"),
     (lambda d: d.update(exploration_factor=math.inf), "exploration_factor"),
     (lambda d: d["fixed"]["#3"].update(kind="billboard"), "kind 'billboard'"),
-    (lambda d: d["fixed"]["#3"].update(x=10**400), "an integer of 401 digits"),
+    (lambda d: d["fixed"]["#3"].update(x=10**400), "an integer of about 401 digits"),
     (lambda d: d.update(hierarchy=[]), "hierarchy"),
     (lambda d: d.update(fixed=None), "fixed"),
     (lambda d: d["params"]["dynamics"].update(max_iterations=10**12), "max_iterations"),
