@@ -555,7 +555,7 @@ def run_world(case: tuple[str, Callable[[Path], None], bool | None], folder: Pat
 
 # -- command arguments and study resume (subprocesses) ------------------------------
 
-def run_command(argv: list[str], timeout: float = 180.0) -> tuple[int | str, str]:
+def run_command(argv: list[str], timeout: float = 600.0) -> tuple[int | str, str]:
     try:
         done = subprocess.run([sys.executable, "-m", "abstract_map.cli", *argv], capture_output=True, text=True,
                               timeout=timeout)
