@@ -159,7 +159,7 @@ class AbstractMap:
                               tuple(self.canonical(r, index) for r in clause.referents), context)
         return Locational(clause.kind, self.canonical(clause.toponym, index), clause.anchor, clause.direction)
 
-    def _check_clause(self, clause: Clause, fixed: Mapping[str, FixedPoint]) -> None:
+    def check_clause(self, clause: Clause, fixed: Mapping[str, FixedPoint]) -> None:
         """Refuse a clause the model could not turn into springs (checked before anything changes)."""
         if isinstance(clause, Relational) and clause.preposition not in TABLE:
             raise CueError(f"clause {clause}: unknown preposition {clause.preposition!r}; known: {sorted(TABLE)}")
@@ -196,7 +196,7 @@ class AbstractMap:
         edges: list[tuple[str, str, str]] = []
         for clause in clauses:
             clause = self._canonical_clause(clause, index)
-            self._check_clause(clause, fixed)
+            self.check_clause(clause, fixed)
             if clause in seen:
                 continue
             seen.add(clause)

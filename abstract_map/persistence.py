@@ -218,7 +218,7 @@ def from_dict(data: Any, *, where: str = "model") -> AbstractMap:
                             explored_centre=None if centre is None else _xy(f"{where} explored_centre", centre,
                                                                             errors.COORDINATE_LIMIT_M))
         for clause in [c for cs in cue_clauses.values() for c in cs] + loose:
-            model._check_clause(clause, fixed)
+            model.check_clause(clause, fixed)
         model.cue_clauses, model.loose_clauses = cue_clauses, loose
         places = set(model.places())
         for key, limit_value in (("positions", errors.COORDINATE_LIMIT_M), ("velocities", errors.VELOCITY_LIMIT_M_S)):
