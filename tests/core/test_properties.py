@@ -24,6 +24,7 @@ from abstract_map import persistence
 from abstract_map.cli import main
 from abstract_map.errors import AbstractMapError
 from abstract_map.grammar import parse_cue
+from tests.conftest import slow_property
 
 from .test_imagine_command import GOOD
 from .test_reliability import state, zoo_map
@@ -163,6 +164,7 @@ def test_any_saved_model_loads_and_settles_or_is_refused(tmp_path_factory, path,
 SUFFIXES = st.sampled_from(["json", "png", "svg", "pdf", "xyz", "", "json/", "PNG"])
 
 
+@slow_property()
 @given(out=st.tuples(st.sampled_from(["r", "sub/r", "a-file/r", ".", "a-file", "s.json", ""]), SUFFIXES),
        plot=st.one_of(st.none(), st.tuples(st.sampled_from(["p", "a-file/p", "r", "sub"]), SUFFIXES)),
        model=st.one_of(st.none(), st.sampled_from(["m.json", "r.json", "a-file", "s.json"])))

@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 
 from abstract_map.cli import main
 from sim.experiments import study, trial
+from tests.conftest import slow_property
 
 
 class Reached(Exception):
@@ -59,6 +60,7 @@ def test_issue9_item6_an_out_that_is_a_file_is_refused_before_the_trial(tiny_wor
     assert existing.read_text() == "an earlier finished trial"
 
 
+@slow_property()
 @given(max_sim_s=st.one_of(st.none(), st.floats(allow_nan=True, allow_infinity=True).map(repr),
                            st.sampled_from(["abc", "", "1e400", "-0", "30"])),
        seed=st.one_of(st.integers(-5, 2**40).map(str), st.sampled_from(["x", "1.5", str(2**70)])),

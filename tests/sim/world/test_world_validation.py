@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 
 from abstract_map.errors import AbstractMapError
 from sim.world.data import WorldError, load_world
+from tests.conftest import slow_property
 
 
 def edit(root: Path, name: str, change) -> Path:
@@ -116,6 +117,7 @@ def template(tmp_path_factory, tiny_world_writer):
     return json.loads((root / "world.json").read_text()), json.loads((root / "tags.json").read_text())
 
 
+@slow_property()
 @given(which=st.sampled_from(["world.json", "tags.json"]), index=st.integers(0, 10_000), value=HOSTILE)
 def test_any_world_folder_loads_and_works_or_is_refused(tmp_path_factory, tiny_world_writer, template, which, index,
                                                          value):
