@@ -139,7 +139,8 @@ def cli(argv: list[str]) -> tuple[int | str, str]:
 
 
 def one_clean_line(stderr: str) -> bool:
-    lines = [line for line in stderr.strip().splitlines() if line.strip()]
+    """One line of stderr, no traceback (pybullet's own banner, printed as it is imported, is not ours)."""
+    lines = [line for line in stderr.strip().splitlines() if line.strip() and not line.startswith("pybullet build")]
     return len(lines) == 1 and "Traceback" not in stderr
 
 

@@ -66,7 +66,7 @@ def _fmt(value: float, spec: str = ".1f") -> str:
 
 
 def _ratio(ours: float, oracle: float) -> str:
-    return "-" if math.isnan(oracle) or math.isnan(ours) else f"{ours / oracle:.2f}"
+    return "-" if math.isnan(oracle) or math.isnan(ours) or oracle <= 0 else f"{ours / oracle:.2f}"
 
 
 def _improvement(ours: float, theirs: float) -> float:

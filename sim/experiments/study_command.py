@@ -42,22 +42,27 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tqdm import tqdm
-
-    from sim.experiments.report import comparison_plot, goal_rows, path_pictures, report_markdown
-    from sim.experiments.study import check_settings, make_executor, plan_specs, run_study, study_settings
     from sim.world.data import load_world
-    from sim.world.oracle import oracle_path
 
+    # every argument checked before the simulator is imported: a bad one costs nothing
     integer("--trials", args.trials, low=1, high=10_001, error=ExitError)
     integer("--workers", args.workers, low=1, high=257, error=ExitError)
     output_folder("--out", args.out)
+    if args.address is not None and args.executor != "ray":
+        raise ExitError("--address: only with --executor ray")
     if args.goals is not None and len(set(args.goals)) < len(args.goals):
         raise ExitError(f"--goals: a goal is named twice in {args.goals}")
     world = load_world(args.world)
     unknown = [g for g in (args.goals or []) if g not in world.goals]
     if unknown:
         raise ExitError(f"--goals: unknown goal(s) {unknown}; goals of {world.name}: {sorted(world.goals)}")
+
+    from tqdm import tqdm
+
+    from sim.experiments.report import comparison_plot, goal_rows, path_pictures, report_markdown
+    from sim.experiments.study import check_settings, make_executor, plan_specs, run_study, study_settings
+    from sim.world.oracle import oracle_path
+
     try:
         executor = make_executor(args.executor, args.workers, args.address)
     except ValueError as exc:

@@ -51,14 +51,16 @@ def check_arguments(args: argparse.Namespace) -> None:
 def run(args: argparse.Namespace) -> int:
     from dataclasses import replace
 
-    from sim.experiments.pictures import animation, trajectory_picture
-    from sim.experiments.trial import TrialParams, run_trial
     from sim.world.data import load_world
 
-    check_arguments(args)
+    check_arguments(args)  # before the simulator is imported: a bad argument costs nothing
     world = load_world(args.world)
     if not world.label_tags(args.goal):
         raise ExitError(f"--goal {args.goal!r}: no label names it in {world.name}; goals: {sorted(world.goals)}")
+
+    from sim.experiments.pictures import animation, trajectory_picture
+    from sim.experiments.trial import TrialParams, run_trial
+
     params = TrialParams()
     if args.max_sim_s is not None:
         params = replace(params, max_sim_s=args.max_sim_s)

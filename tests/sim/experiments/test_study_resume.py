@@ -86,3 +86,10 @@ def test_issue9_item5_the_command_refuses_a_differing_resume(tiny_world, tmp_pat
     assert len(err) == 1 and "perception" in err[0]
     assert main([*base, "--perception", "geometric", "--goals", "A", "A"]) == 2
     assert "--goals" in capsys.readouterr().err
+
+
+def test_a_goal_readable_from_the_start_reports_without_dividing_by_zero(tiny_world):
+    from sim.experiments.report import GoalRow, report_markdown
+
+    row = GoalRow(goal="A", human=[], paper_robot=[], ours=[0.0], failures=0, oracle_m=0.0)
+    assert "| A |" in report_markdown(tiny_world, [row], perception="geometric", trials=1, wall_s=1.0)
