@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from abstract_map.errors import AbstractMapError
-from abstract_map.files import atomic_path, safe_name, write_text_atomic
+from abstract_map.files import atomic_path, json_text, safe_name, write_text_atomic
 from sim.experiments.trial import TrialParams
 from sim.world.data import World
 
@@ -200,7 +200,7 @@ def run_study(world: World, specs: list[TrialSpec], out: Path, *, executor: Proc
     if progress:
         progress(done, len(specs), None)
     for spec, record in executor.map_unordered(run_spec, todo):
-        write_text_atomic(folder / f"{spec.key}.json", json.dumps(record))
+        write_text_atomic(folder / f"{spec.key}.json", json_text(record))
         records[spec.key] = record
         done += 1
         if progress:

@@ -16,13 +16,12 @@ failed (the reason is in result.json), 2 on bad input.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
 from abstract_map.cli import ExitError, output_folder
 from abstract_map.errors import integer, number, place_name
-from abstract_map.files import write_text_atomic
+from abstract_map.files import json_text, write_text_atomic
 
 SUMMARY = "run one closed-loop trial in a pybullet world (needs the [sim] extra)"
 EXTRA = "sim"  # the optional dependencies it needs
@@ -80,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
         raise ExitError(str(exc)) from exc
     if live:
         print(file=sys.stderr)
-    write_text_atomic(args.out / "result.json", json.dumps(result.to_dict(), indent=1, allow_nan=False))
+    write_text_atomic(args.out / "result.json", json_text(result.to_dict(), indent=1))
     trajectory_picture(result, world, args.out / "trajectory.png")
     if args.record:
         animation(result, world, args.out / "run.gif")
