@@ -615,9 +615,13 @@ def argument_inputs(folder: Path) -> list[tuple[str, list[str], bool, Callable[[
     return cases
 
 
+DETAILS: dict[str, str] = {}  # case name -> the end of its stderr, for the report of failures
+
+
 def run_argument(case: tuple[str, list[str], bool, Callable[[], str | None] | None]) -> str:
     name, argv, valid, check = case
     code, err = run_command(argv)
+    DETAILS[name] = f"exit {code}: {' | '.join(err.strip().splitlines()[-3:])}"[:300]
     override = check() if check else None
     if override:
         return override
@@ -721,7 +725,7 @@ def campaign(surfaces: list[str], scale: float, seed: int) -> dict[str, Any]:
         results.setdefault(surface, Counter())[outcome] += 1
         bucket = examples.setdefault(surface, {}).setdefault(outcome, [])
         if outcome not in ("ok", "clean") and len(bucket) < 8:
-            bucket.append(label[:160])
+            bucket.append(label[:400])
 
     def guarded(surface: str, fn: Callable[[], str], label: str) -> None:
         began = time.process_time()
@@ -758,7 +762,8 @@ def campaign(surfaces: list[str], scale: float, seed: int) -> dict[str, Any]:
             cases = argument_inputs(folder / "args")
             with ThreadPoolExecutor(2) as pool:
                 for case, outcome in zip(cases, pool.map(run_argument, cases)):
-                    record("arguments", outcome, case[0])
+                    label = case[0] if outcome in ("ok", "clean") else f"{case[0]} ({DETAILS.get(case[0], '')})"
+                    record("arguments", outcome, label)
         if "study" in surfaces:
             (folder / "study").mkdir()
             for name, fn in study_cases(folder / "study"):
