@@ -404,7 +404,7 @@ elif {kind!r} == "csv":
     from pathlib import Path
     write_csv([{{"goal": f"G{{i}}", "seed": i, "success": True}} for i in range(100)], Path(target))
 """
-    subprocess.run([sys.executable, "-c", code], capture_output=True, timeout=120)
+    subprocess.run([sys.executable, "-c", code], capture_output=True, timeout=600, cwd=folder)
     return "ok" if target.read_text() == '{"earlier": "good"}' or finite_json(target.read_text()) else "lost"
 
 
@@ -558,8 +558,9 @@ def run_world(case: tuple[str, Callable[[Path], None], bool | None], folder: Pat
 
 def run_command(argv: list[str], timeout: float = 600.0) -> tuple[int | str, str]:
     try:
+        # cwd outside any checkout: "python -m" puts its cwd first on sys.path, ahead of PYTHONPATH
         done = subprocess.run([sys.executable, "-m", "abstract_map.cli", *argv], capture_output=True, text=True,
-                              timeout=timeout)
+                              timeout=timeout, cwd=tempfile.gettempdir())
     except subprocess.TimeoutExpired:
         return "timeout", ""
     return done.returncode, done.stderr
