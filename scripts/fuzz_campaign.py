@@ -718,7 +718,8 @@ def study_cases(folder: Path) -> list[tuple[str, Callable[[], str]]]:
 
 def campaign(surfaces: list[str], scale: float, seed: int) -> dict[str, Any]:
     errors = project_errors()
-    rng = random.Random(seed)
+    def rng(surface: str) -> random.Random:  # one stream per surface: a surface alone draws the same inputs
+        return random.Random(f"{seed}-{surface}")
     results: dict[str, Counter] = {}
     examples: dict[str, dict[str, list[str]]] = {}
 
@@ -744,20 +745,20 @@ def campaign(surfaces: list[str], scale: float, seed: int) -> dict[str, Any]:
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         if "cue" in surfaces:
-            for case in cue_inputs(rng, int(600 * scale) + 8):
+            for case in cue_inputs(rng('cue'), int(600 * scale) + 8):
                 guarded("cue text", lambda c=case: run_cue(c, errors), repr(case)[:160])
         if "scenario" in surfaces:
-            for case in scenario_inputs(rng, int(400 * scale) + 23):
+            for case in scenario_inputs(rng('scenario'), int(400 * scale) + 23):
                 guarded("scenario", lambda c=case: run_scenario(c, folder), repr(case)[:160])
             for _ in range(3):
                 record("scenario", disk_full("imagine", folder), "imagine --out on a full disk")
         if "model" in surfaces:
-            for case in model_inputs(rng, int(400 * scale) + 7):
+            for case in model_inputs(rng('model'), int(400 * scale) + 7):
                 guarded("saved model", lambda c=case: run_model(c, folder, errors), repr(case)[:160])
             for _ in range(3):
                 record("saved model", disk_full("model", folder), "save() on a full disk")
         if "world" in surfaces:
-            for case in world_inputs(rng, int(300 * scale) + 27):
+            for case in world_inputs(rng('world'), int(300 * scale) + 27):
                 guarded("world folder", lambda c=case: run_world(c, folder, errors), case[0])
         if "arguments" in surfaces:
             cases = argument_inputs(folder / "args")
