@@ -7,11 +7,13 @@ points (observed tags and the start) are squares, the goal estimate a star.
 from __future__ import annotations
 
 import os
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .clauses import START_ANCHOR, is_anchor
+from .files import atomic_path
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -79,5 +81,8 @@ def save_picture(model: AbstractMap, path: str | os.PathLike[str], *, title: str
     if title:
         ax.set_title(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=120, format=Path(path).suffix.lstrip(".").lower() or "png")
+    finally:
+        plt.close(fig)

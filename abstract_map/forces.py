@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-_DENSE_LIMIT = 250_000  # masses x pairs up to which forces are summed with a dense incidence matrix
+_DENSE_LIMIT = 4_000  # masses x pairs up to which a dense incidence product beats bincounts (measured: 55 vs 60 us
+# at 1,200, 350 vs 140 us at 7,500, 7.9 ms vs 0.15 ms at 270,000; the dense cost is quadratic in a cue's size)
 
 EXPANSION_LAWS: dict[str, Callable[[float, np.ndarray], np.ndarray]] = {
     "constant": lambda c, r: c,  # N, the same for every mass

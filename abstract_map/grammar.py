@@ -20,12 +20,14 @@ import math
 import re
 from dataclasses import dataclass
 
-from .clauses import ANCHOR_PREFIX, Clause, Locational, Relational
-from .prepositions import ARROWS, HERE_WORDS, TABLE
+from .clauses import Clause, Locational, Relational
+from .errors import CueError, place_name, show
+from .prepositions import ARROWS, HERE_WORDS, TABLE, Preposition
 
+__all__ = ["Anchor", "CueError", "parse_cue", "parse_line", "split_lines"]
 
-class CueError(ValueError):
-    """Cue text that the grammar cannot turn into clauses."""
+MAX_CUE_CHARS = 100_000
+"""Characters in one cue's text: far more than any sign (the zoo's longest has 120)."""
 
 
 @dataclass(frozen=True)
@@ -38,7 +40,7 @@ class Anchor:
     theta: float  # rad
 
     def __post_init__(self) -> None:
-        if not all(math.isfinite(v) for v in (self.x, self.y, self.theta)):
+        if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in (self.x, self.y, self.theta)):
             raise CueError(f"anchor {self.name!r}: pose ({self.x}, {self.y}, {self.theta}) must be finite")
 
 
@@ -62,11 +64,7 @@ def split_lines(text: str) -> list[str]:
 def clean_name(name: str, *, where: str) -> str:
     """A place name without its leading article or trailing full stop."""
     cleaned = _ARTICLE.sub("", name.strip().rstrip(".").strip()).strip()
-    if not cleaned:
-        raise CueError(f"{where}: empty place name")
-    if cleaned.startswith(ANCHOR_PREFIX):
-        raise CueError(f"{where}: place name {cleaned!r} may not start with {ANCHOR_PREFIX!r}")
-    return cleaned
+    return place_name(where, cleaned, error=CueError)
 
 
 def split_names(text: str, *, where: str) -> list[str]:
@@ -113,7 +111,7 @@ def parse_phrase(line: str, anchor: Anchor | None, *, where: str) -> list[Clause
     prep_match = _PREPOSITION.match(copula["tail"])
     if prep_match is None:
         word = copula["tail"].split()[0]
-        raise CueError(f"{where}: unknown preposition {word!r}; known prepositions: {sorted(TABLE)}")
+        raise CueError(f"{where}: unknown preposition {show(word)}; known prepositions: {sorted(TABLE)}")
     preposition = prep_match["prep"].lower()
     row = TABLE[preposition]
     figures = [_resolve(f, anchor, where=where) for f in _LIST_SPLIT.split(copula["figures"]) if f.strip()]
@@ -123,11 +121,27 @@ def parse_phrase(line: str, anchor: Anchor | None, *, where: str) -> list[Clause
         raise CueError(f"{where}: {preposition!r} takes {low} to {high} referents, got {len(referents)}")
     if context is None and anchor is not None:
         context = anchor.name
+    _check_roles(figures, referents, context, row, preposition, where=where)
     clauses: list[Clause] = [Relational(preposition, figure, referents, context) for figure in figures]
     if anchor is not None and anchor.name in referents and not row.hierarchy:
         behind = math.remainder(anchor.theta + math.pi, math.tau)
         clauses += [Locational("here", figure, anchor.name, behind) for figure in figures]
     return clauses
+
+
+def _check_roles(figures: list[str], referents: tuple[str, ...], context: str | None, row: Preposition,
+                 preposition: str, *, where: str) -> None:
+    """Refuse a phrase whose places coincide where its springs need distinct masses."""
+    refs = [r.casefold() for r in referents]
+    if len(set(refs)) < len(refs):
+        raise CueError(f"{where}: a referent of {preposition!r} is named twice")
+    for figure in figures:
+        if figure.casefold() in refs:
+            raise CueError(f"{where}: {figure!r} cannot be {preposition} itself")
+    uses_context = any("context" in rule.ends for rule in row.rules)
+    if uses_context and context is not None and context.casefold() in refs + [f.casefold() for f in figures]:
+        raise CueError(f"{where}: {preposition!r} is judged from where the reader stands, which is 'here' "
+                       f"(the sign) unless the line says otherwise; write 'from PLACE, X is {preposition} here'")
 
 
 def parse_line(line: str, anchor: Anchor | None, *, where: str = "cue") -> list[Clause]:
@@ -147,18 +161,22 @@ def looks_like_sign(text: str) -> bool:
 def parse_cue(text: str, anchor: Anchor | None = None, *, kind: str | None = None) -> list[Clause]:
     """Clauses of a cue. ``kind`` is "label", "sign" or None (inferred from the text)."""
     where_tag = f"cue at {anchor.name}" if anchor else "cue"
-    if not isinstance(text, str) or not text.strip():
+    if not isinstance(text, str):
+        raise CueError(f"{where_tag}: text must be a string, got {show(text)}")
+    if not text.strip():
         raise CueError(f"{where_tag}: empty text")
+    if len(text) > MAX_CUE_CHARS:
+        raise CueError(f"{where_tag}: {len(text)} characters; a cue has at most {MAX_CUE_CHARS}")
     if kind is None:
         kind = "sign" if looks_like_sign(text) else "label"
     if kind == "label":
         if anchor is None:
-            raise CueError(f"{where_tag}: a label {text!r} needs the pose of its tag")
-        name = clean_name(text, where=f"{where_tag} label {text!r}")
+            raise CueError(f"{where_tag}: a label {show(text)} needs the pose of its tag")
+        name = clean_name(text, where=f"{where_tag} label {show(text)}")
         return [Locational("label", name, anchor.name, math.remainder(anchor.theta + math.pi, math.tau))]
     if kind != "sign":
-        raise CueError(f"{where_tag}: kind {kind!r} is not 'label' or 'sign'")
+        raise CueError(f"{where_tag}: kind {show(kind)} is not 'label' or 'sign'")
     clauses: list[Clause] = []
     for number, line in enumerate(split_lines(text), start=1):
-        clauses.extend(parse_line(line, anchor, where=f"{where_tag} line {number} {line!r}"))
+        clauses.extend(parse_line(line, anchor, where=f"{where_tag} line {number} {show(line)}"))
     return clauses

@@ -9,7 +9,7 @@ as ``{"Campus": {"A Block": {"Room 1": {}}}}``.
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -18,41 +18,60 @@ from defusedxml import ElementTree
 from defusedxml.common import DefusedXmlException
 
 from .clauses import Relational
+from .errors import HierarchyError, place_name
 
-
-class HierarchyError(ValueError):
-    """A hierarchy that is malformed: bad XML, a place with two parents, a cycle."""
+__all__ = ["Hierarchy", "HierarchyError"]
 
 
 @dataclass
 class Hierarchy:
-    """A forest of places; ``parent[child] = parent``."""
+    """A forest of places; ``parent[child] = parent``.
+
+    Every walk over it is iterative, so its depth is bounded only by memory.
+    """
 
     parent: dict[str, str] = field(default_factory=dict)
     places: list[str] = field(default_factory=list)  # every place, in document order
 
+    def __post_init__(self) -> None:
+        self._known = set(self.places)
+        self._with_children = set(self.parent.values())
+        if len(self._known) != len(self.places):
+            raise HierarchyError("hierarchy: a place is listed twice")
+
+    def copy(self) -> Hierarchy:
+        return Hierarchy(dict(self.parent), list(self.places))
+
     def add(self, child: str, parent: str, *, where: str = "hierarchy") -> bool:
-        """Add the edge child-in-parent; True if it is new."""
+        """Add the edge child-in-parent; True if it is new. A refused edge changes nothing."""
         for name in (child, parent):
-            if name not in self.places:
-                self.places.append(name)
+            place_name(where, name, error=HierarchyError)
         if child == parent:
             raise HierarchyError(f"{where}: {child!r} cannot be in itself")
         if self.parent.get(child) == parent:
             return False
         if child in self.parent:
             raise HierarchyError(f"{where}: {child!r} is already in {self.parent[child]!r}, not also in {parent!r}")
-        node: str | None = parent
-        while node is not None:
-            if node == child:
-                raise HierarchyError(f"{where}: {child!r} in {parent!r} would make a cycle")
-            node = self.parent.get(node)
+        if child in self._with_children:  # a place with no children cannot be an ancestor of its parent
+            node: str | None = parent
+            while node is not None:
+                if node == child:
+                    raise HierarchyError(f"{where}: {child!r} in {parent!r} would make a cycle")
+                node = self.parent.get(node)
+        for name in (child, parent):
+            self.add_place(name)
         self.parent[child] = parent
+        self._with_children.add(parent)
         return True
 
-    def add_place(self, name: str) -> None:
-        if name not in self.places:
+    def add_place(self, name: str, *, where: str = "hierarchy") -> None:
+        if name not in self._known:
+            place_name(where, name, error=HierarchyError)
+            self._known.add(name)
             self.places.append(name)
+
+    def __contains__(self, name: object) -> bool:
+        return isinstance(name, str) and name in self._known
 
     def children(self, name: str) -> list[str]:
         return [c for c in self.places if self.parent.get(c) == name]
@@ -68,18 +87,19 @@ class Hierarchy:
 
     def levels(self) -> dict[str, int]:
         """Level of every place: leaves 1, a parent one above its highest child."""
-        kids: dict[str, list[str]] = {p: [] for p in self.places}
-        for child, parent in self.parent.items():
-            kids[parent].append(child)
-        level: dict[str, int] = {}
-
-        def visit(name: str) -> int:
-            if name not in level:
-                level[name] = 1 + max((visit(c) for c in kids[name]), default=0)
-            return level[name]
-
-        for name in self.places:
-            visit(name)
+        pending = dict.fromkeys(self.places, 0)  # children not yet levelled
+        for parent in self.parent.values():
+            pending[parent] += 1
+        level = dict.fromkeys(self.places, 1)
+        ready = [p for p in self.places if pending[p] == 0]
+        while ready:
+            name = ready.pop()
+            parent = self.parent.get(name)
+            if parent is not None:
+                level[parent] = max(level[parent], level[name] + 1)
+                pending[parent] -= 1
+                if pending[parent] == 0:
+                    ready.append(parent)
         return level
 
     def clauses(self) -> list[Relational]:
@@ -87,33 +107,30 @@ class Hierarchy:
         return [Relational("in", c, (self.parent[c],)) for c in self.places if c in self.parent]
 
     def to_nested(self) -> dict[str, Any]:
-        kids: dict[str, list[str]] = {p: [] for p in self.places}
+        nodes: dict[str, dict[str, Any]] = {p: {} for p in self.places}
         for child in self.places:
             if child in self.parent:
-                kids[self.parent[child]].append(child)
-
-        def nest(name: str) -> dict[str, Any]:
-            return {c: nest(c) for c in kids[name]}
-
-        return {r: nest(r) for r in self.places if r not in self.parent}
+                nodes[self.parent[child]][child] = nodes[child]
+        return {r: nodes[r] for r in self.places if r not in self.parent}
 
     @classmethod
     def from_nested(cls, data: Mapping[str, Any], *, where: str = "hierarchy") -> Hierarchy:
         """From ``{"Campus": {"A Block": {"Room 1": {}}}}``."""
         hierarchy = cls()
-
-        def walk(node: Mapping[str, Any], parent: str | None) -> None:
-            if not isinstance(node, Mapping):
-                raise HierarchyError(f"{where}: expected an object of places, got {type(node).__name__}")
-            for name, children in node.items():
-                if not isinstance(name, str) or not name.strip():
-                    raise HierarchyError(f"{where}: a place needs a non-empty name, got {name!r}")
-                hierarchy.add_place(name)
-                if parent is not None:
-                    hierarchy.add(name, parent, where=where)
-                walk(children or {}, name)
-
-        walk(data, None)
+        if not isinstance(data, Mapping):
+            raise HierarchyError(f"{where}: expected an object of places, got {type(data).__name__}")
+        # depth first, in document order: (name, its children, its parent)
+        stack: list[tuple[Any, Any, str | None]] = [(n, c, None) for n, c in reversed(data.items())]
+        while stack:
+            name, children, parent = stack.pop()
+            hierarchy.add_place(name, where=where)
+            if parent is not None:
+                hierarchy.add(name, parent, where=where)
+            children = {} if children is None else children
+            if not isinstance(children, Mapping):
+                raise HierarchyError(f"{where}: the places in {name!r} must be an object, "
+                                     f"got {type(children).__name__}")
+            stack.extend((n, c, name) for n, c in reversed(children.items()))
         if not hierarchy.places:
             raise HierarchyError(f"{where}: no places")
         return hierarchy
@@ -125,8 +142,8 @@ class Hierarchy:
         try:
             root = ElementTree.parse(str(path)).getroot()
         except OSError as exc:
-            raise HierarchyError(f"{path}: cannot read hierarchy ({exc})") from exc
-        except (ElementTree.ParseError, DefusedXmlException) as exc:
+            raise HierarchyError(f"{path}: cannot read hierarchy ({exc.strerror or exc})") from exc
+        except (ElementTree.ParseError, DefusedXmlException, ValueError) as exc:
             raise HierarchyError(f"{path}: malformed hierarchy XML ({exc})") from exc
         return cls.from_element(root, where=str(path))
 
@@ -134,28 +151,26 @@ class Hierarchy:
     def from_xml_string(cls, text: str, *, where: str = "hierarchy XML") -> Hierarchy:
         try:
             root = ElementTree.fromstring(text)
-        except (ElementTree.ParseError, DefusedXmlException) as exc:
+        except (ElementTree.ParseError, DefusedXmlException, ValueError) as exc:
             raise HierarchyError(f"{where}: malformed hierarchy XML ({exc})") from exc
         return cls.from_element(root, where=where)
 
     @classmethod
     def from_element(cls, root: Any, *, where: str) -> Hierarchy:
         hierarchy = cls()
-
-        def walk(elements: Iterable[Any], parent: str | None) -> None:
-            for element in elements:
-                if element.tag != "place":
-                    raise HierarchyError(f"{where}: unexpected element <{element.tag}>, expected <place name=...>")
-                name = (element.get("name") or "").strip()
-                if not name:
-                    raise HierarchyError(f"{where}: a <place> has no name attribute")
-                hierarchy.add_place(name)
-                if parent is not None:
-                    hierarchy.add(name, parent, where=where)
-                walk(list(element), name)
-
         top = [root] if root.tag == "place" else list(root)
-        walk(top, None)
+        stack: list[tuple[Any, str | None]] = [(e, None) for e in reversed(top)]  # depth first, document order
+        while stack:
+            element, parent = stack.pop()
+            if element.tag != "place":
+                raise HierarchyError(f"{where}: unexpected element <{element.tag}>, expected <place name=...>")
+            name = (element.get("name") or "").strip()
+            if not name:
+                raise HierarchyError(f"{where}: a <place> has no name attribute")
+            hierarchy.add_place(name, where=where)
+            if parent is not None:
+                hierarchy.add(name, parent, where=where)
+            stack.extend((e, name) for e in reversed(list(element)))
         if not hierarchy.places:
             raise HierarchyError(f"{where}: no <place> elements")
         return hierarchy

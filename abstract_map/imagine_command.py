@@ -17,11 +17,11 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .cli import ExitError
-from .grammar import CueError
-from .hierarchy import HierarchyError
-from .model import UnknownPlaceError
-from .scenario import ScenarioError, load_scenario, replay
+from .cli import distinct_outputs, output_file
+from .files import write_text_atomic
+from .scenario import load_scenario, replay
+
+PLOT_SUFFIXES = ("png", "pdf", "svg", "jpg", "jpeg")
 
 SUMMARY = "replay a scenario of cues and write the imagined map after each"
 
@@ -35,21 +35,25 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    try:
-        scenario = load_scenario(args.scenario)
+    output_file("--out", args.out)
+    if args.plot is not None:
+        output_file("--plot", args.plot, suffixes=PLOT_SUFFIXES)
+    if args.save_model is not None:
+        output_file("--save-model", args.save_model)
+    distinct_outputs(scenario=args.scenario, **{"--out": args.out, "--plot": args.plot,
+                                                "--save-model": args.save_model})
+    scenario = load_scenario(args.scenario)
 
-        def progress(i: int, n: int, record: dict[str, Any]) -> None:
-            if not args.quiet:
-                goal = "" if record["goal"] is None else " goal ({:.2f}, {:.2f})".format(*record["goal"])
-                state = "settled" if record["settled"] else "NOT settled"
-                print(f"[{i}/{n}] {record['cue']}: {state} in {record['iterations']} steps, "
-                      f"{record['wall_s'] * 1000:.1f} ms{goal}", file=sys.stderr)
+    def progress(i: int, n: int, record: dict[str, Any]) -> None:
+        if not args.quiet:
+            goal = "" if record["goal"] is None else " goal ({:.2f}, {:.2f})".format(*record["goal"])
+            state = "settled" if record["settled"] else "NOT settled"
+            print(f"[{i}/{n}] {record['cue']}: {state} in {record['iterations']} steps, "
+                  f"{record['wall_s'] * 1000:.1f} ms{goal}", file=sys.stderr)
 
-        model, records = replay(scenario, progress=progress)
-    except (ScenarioError, HierarchyError, CueError, UnknownPlaceError) as exc:
-        raise ExitError(str(exc)) from exc
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(json.dumps({"scenario": str(args.scenario), "steps": records}, indent=1))
+    model, records = replay(scenario, progress=progress)
+    write_text_atomic(args.out, json.dumps({"scenario": str(args.scenario), "steps": records}, indent=1,
+                                           allow_nan=False))
     if args.plot:
         from .drawing import save_picture
 

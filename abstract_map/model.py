@@ -9,6 +9,7 @@ every :meth:`AbstractMap.settle`. World frame, metres, radians.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Iterable, Mapping
@@ -16,22 +17,21 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import errors
 from .clauses import START_ANCHOR, Clause, Locational, Relational, is_anchor, tag_anchor
 from .dynamics import settle as run_dynamics
-from .grammar import Anchor, CueError, parse_cue
+from .errors import CueError, ModelError, UnknownPlaceError
+from .grammar import Anchor, parse_cue
 from .hierarchy import Hierarchy
 from .params import STIFFNESS, AbstractMapParams
 from .placement import Resolved, place_new_masses
-from .prepositions import TABLE
+from .prepositions import LOCATIONAL, TABLE
 from .scales import ScaleKey, learn_scales, natural_length
-from .springs import Spring, springs_from_clauses
+from .springs import Spring, clause_springs, springs_from_clauses
 
+__all__ = ["AbstractMap", "FixedPoint", "Observation", "SettleReport", "UnknownPlaceError", "imagined_positions"]
 
-class UnknownPlaceError(KeyError):
-    """A place that no cue or hierarchy mentions."""
-
-    def __str__(self) -> str:
-        return str(self.args[0])
+FIXED_KINDS = ("label", "sign", "start")
 
 
 @dataclass
@@ -79,10 +79,8 @@ class Observation:
 
 
 def _check_pose(pose: Iterable[float], what: str) -> tuple[float, float, float]:
-    values = tuple(float(v) for v in pose)
-    if len(values) != 3 or not all(math.isfinite(v) for v in values):
-        raise ValueError(f"{what}: expected a finite pose (x m, y m, theta rad), got {tuple(pose)!r}")
-    return values  # type: ignore[return-value]
+    """(x m, y m, theta rad) within the ranges of :mod:`errors`, else a :class:`ModelError`."""
+    return errors.pose(what, pose, error=ModelError)
 
 
 @dataclass
@@ -103,6 +101,10 @@ class AbstractMap:
     start_roots: list[str] = field(default_factory=list)
 
     def __post_init__(self) -> None:
+        if not isinstance(self.hierarchy, Hierarchy):
+            raise ModelError(f"hierarchy: expected a Hierarchy, got {type(self.hierarchy).__name__}")
+        if not isinstance(self.params, AbstractMapParams):
+            raise ModelError(f"params: expected AbstractMapParams, got {type(self.params).__name__}")
         self.start = _check_pose(self.start, "start pose")
         self.fixed.setdefault(START_ANCHOR, FixedPoint("start", *self.start, text="start"))
         if not self.start_roots:
@@ -157,37 +159,72 @@ class AbstractMap:
                               tuple(self.canonical(r, index) for r in clause.referents), context)
         return Locational(clause.kind, self.canonical(clause.toponym, index), clause.anchor, clause.direction)
 
-    def _check_clause(self, clause: Clause) -> None:
+    def check_clause(self, clause: Clause, fixed: Mapping[str, FixedPoint]) -> None:
+        """Refuse a clause the model could not turn into springs (checked before anything changes)."""
         if isinstance(clause, Relational) and clause.preposition not in TABLE:
             raise CueError(f"clause {clause}: unknown preposition {clause.preposition!r}; known: {sorted(TABLE)}")
+        if isinstance(clause, Locational):
+            if clause.kind not in LOCATIONAL:
+                raise CueError(f"clause {clause}: locational kind {clause.kind!r}; known: {sorted(LOCATIONAL)}")
+            if not is_anchor(clause.anchor):
+                raise CueError(f"clause {clause}: {clause.anchor!r} is not a fixed point")
+            errors.number(f"clause {clause} direction", clause.direction, low=-4.0, high=4.0, error=CueError)
         for name in _clause_names(clause):
-            if is_anchor(name) and name not in self.fixed:
-                raise CueError(f"clause {clause}: fixed point {name!r} has not been observed")
+            if not isinstance(name, str):
+                raise CueError(f"clause {clause}: a name must be text, got {errors.show(name)}")
+            if is_anchor(name):
+                if name not in fixed:
+                    raise CueError(f"clause {clause}: fixed point {name!r} has not been observed")
+            else:
+                errors.place_name(f"clause {clause}", name, error=CueError)
+        try:
+            clause_springs(clause, lambda anchor: fixed[anchor].kind, {"between_angle": self.params.between_angle})
+        except ValueError as exc:
+            raise CueError(f"{exc}; the cue is refused") from None
+
+    def _prepare(self, clauses: Iterable[Clause], fixed: Mapping[str, FixedPoint],
+                 *, skip: Iterable[Clause] = ()) -> tuple[list[Clause], list[tuple[str, str, str]]]:
+        """Canonical, checked clauses and the hierarchy edges they add; changes nothing.
+
+        Raises :class:`CueError` (or :class:`HierarchyError`) for the first clause the model
+        cannot take, with the model untouched: a cue is applied whole or not at all.
+        """
+        index = self._name_index()
+        trial = self.hierarchy.copy()
+        seen = set(skip)
+        out: list[Clause] = []
+        edges: list[tuple[str, str, str]] = []
+        for clause in clauses:
+            clause = self._canonical_clause(clause, index)
+            self.check_clause(clause, fixed)
+            if clause in seen:
+                continue
+            seen.add(clause)
+            if isinstance(clause, Relational) and TABLE[clause.preposition].hierarchy:
+                for parent in clause.referents:
+                    if not is_anchor(parent) and not is_anchor(clause.figure):
+                        where = f"clause {clause}"
+                        trial.add(clause.figure, parent, where=where)
+                        edges.append((clause.figure, parent, where))
+            out.append(clause)
+        return out, edges
+
+    def _commit_edges(self, edges: Iterable[tuple[str, str, str]]) -> None:
+        for child, parent, where in edges:  # already checked on a copy: cannot fail
+            self.hierarchy.add(child, parent, where=where)
 
     def add_clauses(self, clauses: Iterable[Clause]) -> list[Clause]:
         """Add clauses with no tag of their own (e.g. spoken directions); returns the new ones.
 
         "X is in Y" clauses also extend the hierarchy. A new clause resets exploration.
+        The clauses are checked together first: if one is refused, none is added.
         """
-        added = []
-        index = self._name_index()
-        for clause in clauses:
-            clause = self._canonical_clause(clause, index)
-            self._check_clause(clause)
-            if clause in self.loose_clauses:
-                continue
-            self._extend_hierarchy(clause)
-            self.loose_clauses.append(clause)
-            added.append(clause)
+        added, edges = self._prepare(list(clauses), self.fixed, skip=self.loose_clauses)
+        self._commit_edges(edges)
+        self.loose_clauses.extend(added)
         if added:
             self.exploration_factor = 1.0
         return added
-
-    def _extend_hierarchy(self, clause: Clause) -> None:
-        if isinstance(clause, Relational) and TABLE[clause.preposition].hierarchy:
-            for parent in clause.referents:
-                if not is_anchor(parent) and not is_anchor(clause.figure):
-                    self.hierarchy.add(clause.figure, parent, where=f"clause {clause}")
 
     def observe_tag(self, tag_id: int, text: str, pose: Iterable[float], *, kind: str | None = None) -> Observation:
         """A tag read at world ``pose`` = (x m, y m, theta rad, the direction its face points).
@@ -196,39 +233,44 @@ class AbstractMap:
         "sign", inferred from the text when None). Seeing the tag again moves the fixed
         mass to the mean of all sightings and re-derives its clauses, never adding
         springs twice. A first sighting resets the exploration factor to 1.
+        The cue is parsed and checked completely before the model changes: a refused
+        cue (:class:`CueError`, :class:`ModelError`) leaves the model exactly as it was.
         """
-        x, y, theta = _check_pose(pose, f"tag {tag_id} pose")
-        name = tag_anchor(int(tag_id))
-        point = self.fixed.get(name)
-        new = point is None
-        if point is None:
-            clauses = parse_cue(text, Anchor(name, x, y, theta), kind=kind)
-            kind = "label" if all(isinstance(c, Locational) and c.kind == "label" for c in clauses) else "sign"
+        tag = errors.tag_id("tag id", tag_id, error=ModelError)
+        x, y, theta = _check_pose(pose, f"tag {tag} pose")
+        if not isinstance(text, str):
+            raise CueError(f"tag {tag}: text must be a string, got {errors.show(text)}")
+        if kind is not None and kind not in ("label", "sign"):
+            raise CueError(f"tag {tag}: kind {errors.show(kind)} is not 'label' or 'sign'")
+        name = tag_anchor(tag)
+        earlier = self.fixed.get(name)
+        if earlier is None:
+            first = parse_cue(text, Anchor(name, x, y, theta), kind=kind)
+            kind = "label" if all(isinstance(c, Locational) and c.kind == "label" for c in first) else "sign"
             point = FixedPoint(kind, x, y, theta, text=text)
-            self.fixed[name] = point
         else:
-            if text != point.text:
-                raise CueError(f"tag {tag_id}: text {text!r} differs from its earlier reading {point.text!r}")
+            if text != earlier.text:
+                raise CueError(f"tag {tag}: text {errors.show(text)} differs from its earlier reading "
+                               f"{errors.show(earlier.text)}")
+            point = dataclasses.replace(earlier)
             point.add_sighting(x, y, theta)
-        try:
-            index = self._name_index()
-            clauses = [self._canonical_clause(c, index) for c in
-                       parse_cue(point.text, Anchor(name, point.x, point.y, point.theta), kind=point.kind)]
-            for clause in clauses:
-                self._check_clause(clause)
-                self._extend_hierarchy(clause)
-        except Exception:
-            if new:
-                del self.fixed[name]
-            raise
-        if new:
+        fixed = {**self.fixed, name: point}
+        parsed = parse_cue(point.text, Anchor(name, point.x, point.y, point.theta), kind=point.kind)
+        clauses, edges = self._prepare(parsed, fixed)
+        # commit: nothing below can fail
+        self._commit_edges(edges)
+        if earlier is None:
+            self.fixed[name] = point
             self.exploration_factor = 1.0
             for clause in clauses:  # reality overrides imagination: re-place newly observed places
                 if isinstance(clause, Locational) and clause.kind == "label" and not self.is_observed(clause.toponym):
                     self.positions.pop(clause.toponym, None)
                     self.velocities.pop(clause.toponym, None)
+        else:
+            for f in dataclasses.fields(point):
+                setattr(earlier, f.name, getattr(point, f.name))
         self.cue_clauses[name] = clauses
-        return Observation(int(tag_id), new, tuple(clauses))
+        return Observation(tag, earlier is None, tuple(clauses))
 
     # -- reading ------------------------------------------------------------------
 
@@ -243,6 +285,10 @@ class AbstractMap:
         for root in self.start_roots:
             springs.append(Spring("distance", (root, START_ANCHOR), 1.0, k, "start"))
             springs.append(Spring("global_angle", (START_ANCHOR, root), self.start[2], k))
+        k = STIFFNESS[self.params.loose_stiffness]
+        for first in _loose_groups(self.places(), springs):
+            springs.append(Spring("distance", (first, START_ANCHOR), 1.0, k, "start"))
+            springs.append(Spring("global_angle", (START_ANCHOR, first), self.start[2], k))
         return springs
 
     def levels(self) -> dict[str, int]:
@@ -287,6 +333,8 @@ class AbstractMap:
 
     def position(self, place: str) -> np.ndarray:
         """Imagined position (m, world) of a place."""
+        if not isinstance(place, str):
+            raise UnknownPlaceError(f"place: a place name must be text, got {errors.show(place)}")
         name = self.canonical(place)
         if name not in self.positions:
             known = self.places()
@@ -296,6 +344,7 @@ class AbstractMap:
         return self.positions[name].copy()
 
     def set_goal(self, place: str) -> None:
+        errors.place_name("goal", place, error=UnknownPlaceError)
         name = self.canonical(place)
         if name not in self.places():
             raise UnknownPlaceError(f"goal {place!r} is not mentioned by any cue or the hierarchy; "
@@ -312,8 +361,9 @@ class AbstractMap:
 
     def bump_exploration(self) -> float:
         """The goal was not where imagined: grow imagined distances by the exploration step."""
-        step, law = self.params.exploration.step, self.params.exploration.law
-        self.exploration_factor = EXPLORATION_LAWS[law](self.exploration_factor, step)
+        exploration = self.params.exploration
+        grown = EXPLORATION_LAWS[exploration.law](self.exploration_factor, exploration.step)
+        self.exploration_factor = min(grown, exploration.max_factor)
         return self.exploration_factor
 
     def set_explored_centre(self, xy: Iterable[float] | None) -> None:
@@ -321,10 +371,14 @@ class AbstractMap:
         if xy is None:
             self.explored_centre = None
             return
-        centre = np.array([float(v) for v in xy])
-        if centre.shape != (2,) or not np.all(np.isfinite(centre)):
-            raise ValueError(f"explored centre: expected finite (x, y) in metres, got {xy!r}")
-        self.explored_centre = centre
+        try:
+            values = list(xy)
+        except TypeError:
+            raise ModelError(f"explored centre: expected (x, y) in metres, got {errors.show(xy)}") from None
+        if len(values) != 2:
+            raise ModelError(f"explored centre: expected (x, y) in metres, got {errors.show(xy)}")
+        self.explored_centre = np.array([errors.coordinate(f"explored centre {axis}", v, ModelError)
+                                         for axis, v in zip("xy", values)])
 
     def settle(self) -> SettleReport:
         """Place new masses (Algorithm 2), then integrate until settled (Algorithm 1)."""
@@ -345,6 +399,13 @@ class AbstractMap:
         result = run_dynamics({p: self.positions[p] for p in places}, self.velocities,
                               {n: f.xy for n, f in self.fixed.items()}, springs,
                               expand=expand, centre=self.explored_centre, params=self.params.dynamics)
+        bad = [n for n, xy in result.positions.items() if not np.all(np.abs(xy) <= errors.COORDINATE_LIMIT_M)]
+        if bad:  # never expected with checked inputs: refuse rather than hand out NaN
+            for name in placed:
+                self.positions.pop(name, None)
+                self.velocities.pop(name, None)
+            raise ModelError(f"settle diverged: {bad[0]!r} left the +-{errors.COORDINATE_LIMIT_M:g} m range; "
+                             "the model is unchanged")
         self.positions.update(result.positions)
         self.velocities.update(result.velocities)
         return SettleReport(result.settled, result.iterations, time.perf_counter() - began, tuple(new))
@@ -354,6 +415,36 @@ EXPLORATION_LAWS = {
     "multiplicative": lambda factor, step: factor * (1.0 + step),
     "additive": lambda factor, step: factor + step,
 }
+
+
+def _loose_groups(places: list[str], springs: list[Spring]) -> list[str]:
+    """The first place (in ``places`` order) of each group that no chain of springs ties to a fixed point."""
+    parent = {p: p for p in places}
+
+    def find(name: str) -> str:
+        root = name
+        while parent[root] != root:
+            root = parent[root]
+        while parent[name] != root:
+            parent[name], name = root, parent[name]
+        return root
+
+    anchored: set[str] = set()
+    for spring in springs:
+        ends = [e for e in spring.ends if e in parent]
+        if len(ends) < len(spring.ends):
+            anchored.update(ends)  # a fixed point holds this spring's places
+        for other in ends[1:]:
+            a, b = find(ends[0]), find(other)
+            if a != b:
+                parent[b] = a
+    held = {find(p) for p in anchored}
+    firsts: dict[str, str] = {}
+    for place in places:
+        root = find(place)
+        if root not in held:
+            firsts.setdefault(root, place)
+    return list(firsts.values())
 
 
 def _clause_names(clause: Clause) -> list[str]:

@@ -33,6 +33,31 @@ class ScaleDefaults:
     # m, place to its own label, by place level; never learned
     label: dict[int, float] = field(default_factory=lambda: {1: 2.0, 2: 12.5, 3: 20.0})
 
+    def __post_init__(self) -> None:
+        """Each table covers every level (pair a <= b) from 1 to its top, in metres in (0, 1e6]."""
+        for table_name in ("place", "sign", "label"):
+            table = getattr(self, table_name)
+            if not isinstance(table, dict) or not table:
+                raise ValueError(f"ScaleDefaults.{table_name} must be a non-empty table")
+            for key, value in table.items():
+                _positive(f"ScaleDefaults.{table_name}[{key!r}]", value)
+        for table_name in ("sign", "label"):
+            table = getattr(self, table_name)
+            if not all(isinstance(k, int) and not isinstance(k, bool) for k in table):
+                raise ValueError(f"ScaleDefaults.{table_name}: levels must be integers, got {sorted(map(str, table))}")
+            top = max(table)
+            if top > 100 or set(table) != set(range(1, top + 1)):
+                raise ValueError(f"ScaleDefaults.{table_name}: expected levels 1 to N (N <= 100), got {sorted(table)}")
+        pairs = self.place
+        if not all(isinstance(k, tuple) and len(k) == 2 and all(isinstance(v, int) and not isinstance(v, bool)
+                                                                for v in k) for k in pairs):
+            raise ValueError(f"ScaleDefaults.place: keys must be level pairs (a, b), got {list(pairs)[:5]}")
+        top = max(max(k) for k in pairs)
+        expected = {(a, b) for a in range(1, top + 1) for b in range(a, top + 1)}
+        if top > 100 or set(pairs) != expected:
+            raise ValueError(f"ScaleDefaults.place: expected every level pair a <= b from 1 to N (N <= 100), "
+                             f"got {sorted(pairs)[:10]}")
+
 
 @dataclass(frozen=True)
 class DynamicsParams:
@@ -53,8 +78,12 @@ class DynamicsParams:
     def __post_init__(self) -> None:
         _choice("DynamicsParams.expansion_law", self.expansion_law, ("constant", "proportional"))
         _choice("DynamicsParams.expansion_on", self.expansion_on, ("leaves", "all"))
-        for name in ("mass", "dt", "settle_acceleration", "settle_velocity", "max_iterations"):
+        for name in ("mass", "settle_acceleration", "settle_velocity"):
             _positive(f"DynamicsParams.{name}", getattr(self, name))
+        _positive("DynamicsParams.dt", self.dt, high=10.0)
+        if isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int):
+            raise ValueError(f"DynamicsParams.max_iterations must be an integer, got {self.max_iterations!r}")
+        _positive("DynamicsParams.max_iterations", self.max_iterations, high=1e6)
         for name in ("friction", "expansion", "min_separation", "angle_core"):
             _positive(f"DynamicsParams.{name}", getattr(self, name), allow_zero=True)
 
@@ -65,10 +94,16 @@ class ExplorationParams:
 
     step: float = 0.25  # 25 % per bump
     law: str = "multiplicative"  # "multiplicative" (paper: E *= 1 + step) or "additive" (authors: E += step)
+    # E stops growing here (1.25**20 ~ 87): imagined distances 100 times the building's scale are past any
+    # building, and an unbounded E would overflow to inf after ~3,000 bumps
+    max_factor: float = 100.0
 
     def __post_init__(self) -> None:
         _choice("ExplorationParams.law", self.law, ("multiplicative", "additive"))
-        _positive("ExplorationParams.step", self.step)
+        _positive("ExplorationParams.step", self.step, high=10.0)
+        _positive("ExplorationParams.max_factor", self.max_factor, high=1e4)
+        if self.max_factor < 1.0:
+            raise ValueError(f"ExplorationParams.max_factor must be >= 1, got {self.max_factor!r}")
 
 
 @dataclass(frozen=True)
@@ -80,9 +115,18 @@ class AbstractMapParams:
     exploration: ExplorationParams = field(default_factory=ExplorationParams)
     start_stiffness: str = "S"  # the start pose's pull on the hierarchy root(s), a STIFFNESS name
     between_angle: bool = True  # add the relative angle of pi at the figure between two referents
+    # The start's pull (a STIFFNESS name, N/m and N/rad) on the first place of each group of places that no
+    # chain of springs ties to a fixed point (e.g. an untagged "X is near Y" about two unknown places), as
+    # on a hierarchy root. Without it the expansion force (0.01 N against 0.1 N s/m of friction) drives such
+    # a group at 0.1 m/s for as long as a settle runs: ~50 m per settle, without limit. With it the group's
+    # drift is bounded: it rests one label scale (2 m for a leaf) ahead of the start until a cue ties it in.
+    loose_stiffness: str = "S"
 
     def __post_init__(self) -> None:
         _choice("AbstractMapParams.start_stiffness", self.start_stiffness, tuple(STIFFNESS))
+        _choice("AbstractMapParams.loose_stiffness", self.loose_stiffness, tuple(STIFFNESS))
+        if not isinstance(self.between_angle, bool):
+            raise ValueError(f"AbstractMapParams.between_angle must be true or false, got {self.between_angle!r}")
 
 
 def _choice(name: str, value: str, allowed: tuple[str, ...]) -> None:
@@ -90,6 +134,13 @@ def _choice(name: str, value: str, allowed: tuple[str, ...]) -> None:
         raise ValueError(f"{name} is {value!r}; expected one of {list(allowed)}")
 
 
-def _positive(name: str, value: float, *, allow_zero: bool = False) -> None:
-    if not (math.isfinite(value) and (value >= 0 if allow_zero else value > 0)):
-        raise ValueError(f"{name} must be finite and {'>= 0' if allow_zero else '> 0'}, got {value!r}")
+def _positive(name: str, value: float, *, allow_zero: bool = False, high: float = 1e6) -> None:
+    """A real number (not a bool) in (0, high], or [0, high] with ``allow_zero``."""
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+    try:
+        ok = ok and math.isfinite(value) and (value >= 0 if allow_zero else value > 0) and value <= high
+    except OverflowError:
+        ok = False
+    if not ok:
+        raise ValueError(f"{name} must be a finite number {'>= 0' if allow_zero else '> 0'} and <= {high:g}, "
+                         f"got {value!r}"[:300])

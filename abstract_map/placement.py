@@ -74,6 +74,7 @@ def place_new_masses(new: Sequence[str], known: Mapping[str, np.ndarray], spring
     for name in order:
         offer(name)
     fan_count: dict[str, int] = {}
+    crowded: dict[tuple[int, int], int] = {}  # spiral turns used around each crowded spot
     result: dict[str, np.ndarray] = {}
     points = np.zeros((len(placed) + len(order), 2))  # every placed position, for the separation check
     points[:len(placed)] = list(placed.values()) if placed else np.zeros((0, 2))
@@ -89,7 +90,7 @@ def place_new_masses(new: Sequence[str], known: Mapping[str, np.ndarray], spring
             name = None if candidate in result else candidate
         mine = touching.get(name, [])
         position = _best_position(name, mine, placed, fan_count, origin=origin, heading=heading)
-        position = _separate(position, points[:count], min_separation)
+        position = _separate(position, points[:count], min_separation, crowded)
         placed[name] = result[name] = position
         points[count] = position
         count += 1
@@ -156,11 +157,32 @@ def _best_position(name: str, springs: Sequence[Resolved], placed: Mapping[str, 
     return _fit_distances(start, points, lengths, weights)
 
 
-def _separate(position: np.ndarray, points: np.ndarray, min_separation: float) -> np.ndarray:
-    """Nudge a position so that it keeps ``min_separation`` (m) from every point of ``points`` (M, 2)."""
+def _separate(position: np.ndarray, points: np.ndarray, min_separation: float,
+              crowded: dict[tuple[int, int], int] | None = None) -> np.ndarray:
+    """Nudge a position so that it keeps ``min_separation`` (m) from every point of ``points`` (M, 2).
+
+    Sixteen nudges around the spot first; if all are taken (many masses sharing one spot, e.g. a
+    sign with hundreds of arrows one way), the first free point of a golden-angle spiral about the
+    spot, continuing where the last mass placed there left off, so n masses at one spot cost O(n)
+    tries and none overlaps (overlapping masses make pymunk's collision work quadratic).
+    """
+    original = position
     position = position.copy()
     for k in range(16):
-        if len(points) == 0 or np.hypot(*(points - position).T).min() >= min_separation:
-            break
+        if _free(position, points, min_separation):
+            return position
         position = position + min_separation * _unit(_fan_angle(k + 1) * 2.0)
-    return position
+    if min_separation <= 0 or crowded is None:
+        return position
+    key = (int(round(original[0] / min_separation)), int(round(original[1] / min_separation)))
+    k = crowded.get(key, 0)
+    while True:
+        k += 1
+        candidate = original + min_separation * math.sqrt(k) * _unit(k * math.tau * GOLDEN)
+        if _free(candidate, points, min_separation):
+            crowded[key] = k
+            return candidate
+
+
+def _free(position: np.ndarray, points: np.ndarray, min_separation: float) -> bool:
+    return len(points) == 0 or float(np.hypot(*(points - position).T).min()) >= min_separation

@@ -28,7 +28,9 @@ from typing import Any
 
 import numpy as np
 
+from . import errors
 from .clauses import tag_anchor
+from .errors import ScenarioError
 from .grammar import Anchor, parse_cue
 from .hierarchy import Hierarchy
 from .model import AbstractMap, SettleReport, imagined_positions
@@ -37,9 +39,6 @@ from .params import AbstractMapParams
 _SCENARIO_KEYS = {"hierarchy", "start", "goal", "steps"}
 _STEP_KEYS = {"text", "tag", "pose", "kind", "explored_centre"}
 
-
-class ScenarioError(ValueError):
-    """A scenario file that cannot be replayed."""
 
 
 @dataclass(frozen=True)
@@ -81,15 +80,12 @@ def _keys(where: str, data: Any, allowed: set[str], required: set[str]) -> None:
 
 
 def _numbers(where: str, value: Any, n: int) -> list[float]:
+    """[x m, y m] or [x m, y m, angle deg]: finite, coordinates and angle within the ranges of :mod:`errors`."""
     if not isinstance(value, list) or len(value) != n:
-        raise ScenarioError(f"{where}: expected a list of {n} numbers, got {value!r}")
-    try:
-        numbers = [float(v) for v in value]
-    except (TypeError, ValueError):
-        raise ScenarioError(f"{where}: expected a list of {n} numbers, got {value!r}") from None
-    if not all(math.isfinite(v) for v in numbers):
-        raise ScenarioError(f"{where}: expected finite numbers, got {value!r}")
-    return numbers
+        raise ScenarioError(f"{where}: expected a list of {n} numbers, got {errors.show(value)}")
+    names = ("x", "y", "angle")
+    return [errors.coordinate(f"{where} {names[i]}", v, ScenarioError) if i < 2
+            else errors.angle(f"{where} {names[i]}", v, ScenarioError) for i, v in enumerate(value)]
 
 
 def _step(where: str, data: Any) -> Step:
@@ -98,12 +94,13 @@ def _step(where: str, data: Any) -> Step:
         raise ScenarioError(f"{where}: 'text' must be non-empty text")
     if ("tag" in data) != ("pose" in data):
         raise ScenarioError(f"{where}: 'tag' and 'pose' go together")
+    if data.get("kind") not in (None, "label", "sign"):
+        raise ScenarioError(f"{where}: 'kind' must be 'label' or 'sign', got {errors.show(data['kind'])}")
     pose = None
     if "pose" in data:
         x, y, theta = _numbers(f"{where} pose", data["pose"], 3)
         pose = (x, y, math.radians(theta))
-        if not isinstance(data["tag"], int):
-            raise ScenarioError(f"{where}: 'tag' must be an integer id, got {data['tag']!r}")
+        errors.tag_id(f"{where} tag", data["tag"], ScenarioError)
     centre = data.get("explored_centre")
     return Step(data["text"], data.get("tag"), pose, data.get("kind"),
                 None if centre is None else tuple(_numbers(f"{where} explored_centre", centre, 2)))  # type: ignore[arg-type]
@@ -113,11 +110,11 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
     """Read and check a scenario file."""
     path = Path(path)
     try:
-        data = json.loads(path.read_text())
+        data = json.loads(path.read_text(encoding="utf-8"))
     except OSError as exc:
-        raise ScenarioError(f"{path}: cannot read scenario ({exc.strerror})") from exc
-    except json.JSONDecodeError as exc:
-        raise ScenarioError(f"{path}: not valid JSON ({exc})") from exc
+        raise ScenarioError(f"{path}: cannot read scenario ({exc.strerror or exc})") from exc
+    except (ValueError, RecursionError) as exc:  # JSONDecodeError and UnicodeDecodeError are ValueErrors
+        raise ScenarioError(f"{path}: not valid JSON ({errors.one_line(str(exc), 120)})") from None
     where = str(path)
     _keys(where, data, _SCENARIO_KEYS, {"hierarchy", "start", "steps"})
     spec = data["hierarchy"]
@@ -130,6 +127,8 @@ def load_scenario(path: str | os.PathLike[str]) -> Scenario:
     x, y, heading = _numbers(f"{where} start", data["start"], 3)
     if not isinstance(data["steps"], list):
         raise ScenarioError(f"{where}: 'steps' must be a list")
+    if data.get("goal") is not None:
+        errors.place_name(f"{where} goal", data["goal"], error=ScenarioError)
     steps = [_step(f"{where} step {i}", s) for i, s in enumerate(data["steps"])]
     scenario = Scenario(hierarchy, (x, y, math.radians(heading)), steps, data.get("goal"))
     _check_goal(scenario, where)

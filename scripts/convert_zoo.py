@@ -9,11 +9,12 @@ real newlines.
 from __future__ import annotations
 
 import json
-import shutil
 import sys
 from pathlib import Path
 
 from defusedxml import ElementTree
+
+from abstract_map.files import write_bytes_atomic, write_text_atomic
 
 KINDS = {"LABEL": "label", "INFO": "sign", "EMPTY": "empty"}
 GOALS = {"Kingfisher": 10, "Toilets": 24, "Lion": 17, "Polar bear": 27, "Anaconda": 38}
@@ -22,7 +23,7 @@ GOALS = {"Kingfisher": 10, "Toilets": 24, "Lion": 17, "Polar bear": 27, "Anacond
 def convert(source: Path, dest: Path) -> None:
     dest.mkdir(parents=True, exist_ok=True)
     for name in ("floorplan.png", "hierarchy.xml", "LICENSE-QUT.txt"):
-        shutil.copyfile(source / name, dest / name)
+        write_bytes_atomic(dest / name, (source / name).read_bytes())
     mapping = ElementTree.parse(source / "cue_mapping.xml").getroot()
     cues = {int(m.get("tag_id")): (KINDS[m.get("type")], m.get("text").replace("\\n", "\n"))
             for m in mapping.iter("mapping")}
@@ -34,7 +35,7 @@ def convert(source: Path, dest: Path) -> None:
         kind, text = cues[int(tag_id)]
         tags.append({"id": int(tag_id), "x_m": round(float(x), 4), "y_m": round(float(y), 4),
                      "theta_deg": round(float(theta), 3), "kind": kind, "text": text})
-    (dest / "tags.json").write_text(json.dumps({"name": mapping.get("name"), "tags": tags}, indent=1) + "\n")
+    write_text_atomic(dest / "tags.json", json.dumps({"name": mapping.get("name"), "tags": tags}, indent=1) + "\n")
     world = {
         "format": "abstract-map-world/1",
         "name": "zoo",
@@ -50,7 +51,7 @@ def convert(source: Path, dest: Path) -> None:
         "walls": {"height_m": 2.0},
         "licence": "LICENSE-QUT.txt",
     }
-    (dest / "world.json").write_text(json.dumps(world, indent=2) + "\n")
+    write_text_atomic(dest / "world.json", json.dumps(world, indent=2) + "\n")
 
 
 if __name__ == "__main__":

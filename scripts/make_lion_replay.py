@@ -9,6 +9,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from abstract_map.files import write_text_atomic
+
 LION_TAGS = [0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 13, 14, 15, 16]
 
 
@@ -24,7 +26,7 @@ def main() -> None:
         "steps": [{"text": tags[i]["text"], "tag": i,
                    "pose": [tags[i]["x_m"], tags[i]["y_m"], tags[i]["theta_deg"]]} for i in LION_TAGS],
     }
-    (zoo / "lion_replay.json").write_text(json.dumps(scenario, indent=1) + "\n")
+    write_text_atomic(zoo / "lion_replay.json", json.dumps(scenario, indent=1) + "\n")
     print(f"wrote {zoo / 'lion_replay.json'}")
 
 

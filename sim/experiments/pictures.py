@@ -12,6 +12,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from abstract_map.files import atomic_path
+
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
@@ -83,7 +85,8 @@ def trajectory_picture(result: TrialResult, world: World, path: str | os.PathLik
                  f"{result.distance_m:.1f} m, {len(result.cues)} cues")
     ax.legend(loc="lower right")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
 
 
@@ -107,8 +110,9 @@ def animation(result: TrialResult, world: World, path: str | os.PathLike[str], *
     plt.close(fig)
     if not images:
         raise ValueError("no frames were recorded: run the trial with record=True")
-    imageio.mimsave(path, images, duration=1000 / fps, loop=0) if str(path).endswith(".gif") else \
-        imageio.mimsave(path, images, fps=fps)
+    with atomic_path(path) as tmp:
+        imageio.mimsave(tmp, images, duration=1000 / fps, loop=0) if str(path).endswith(".gif") else \
+            imageio.mimsave(tmp, images, fps=fps)
 
 
 def _draw_frame(ax: Axes, frame: Frame, result: TrialResult, world: World) -> None:

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from abstract_map.files import atomic_path
 from sim.experiments.pictures import draw_floorplan, draw_path, draw_tags
 from sim.experiments.study import slug
 from sim.world.data import World
@@ -66,7 +67,7 @@ def _fmt(value: float, spec: str = ".1f") -> str:
 
 
 def _ratio(ours: float, oracle: float) -> str:
-    return "-" if math.isnan(oracle) or math.isnan(ours) else f"{ours / oracle:.2f}"
+    return "-" if math.isnan(oracle) or math.isnan(ours) or oracle <= 0 else f"{ours / oracle:.2f}"
 
 
 def _improvement(ours: float, theirs: float) -> float:
@@ -141,7 +142,8 @@ def comparison_plot(rows: list[GoalRow], path: str | os.PathLike[str]) -> None:
     ax.legend(loc="lower right")
     ax.set_title("Finding goals in the zoo: humans, the paper's robot, ours")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=120)
     plt.close(fig)
 
 
@@ -176,7 +178,8 @@ def path_pictures(world: World, records: list[dict[str, Any]], oracles: dict[str
         ax.legend(loc="lower right", fontsize=7)
         fig.tight_layout()
         path = folder / f"{slug(goal)}.png"  # a safe name: a goal's text never leaves the folder
-        fig.savefig(path, dpi=100)
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=100)
         plt.close(fig)
         written.append(path)
     return written

@@ -67,6 +67,8 @@ def run(args: argparse.Namespace) -> int:
 
     if args.trials < 1 or args.workers < 1:
         raise ExitError("--trials and --workers must be at least 1")
+    if args.goals and len(set(args.goals)) != len(args.goals):
+        raise ExitError(f"--goals {args.goals}: a goal is named twice")
     settings = StudySettings(worlds=tuple(args.world or ["zoo"]), perception=args.perception,
                              navigators=navigator_list(args.navigator), trials=args.trials,
                              goals=tuple(args.goals) if args.goals else None)

@@ -17,11 +17,12 @@ failed (the reason is in result.json), 2 on bad input.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
-from abstract_map.cli import ExitError
+from abstract_map.cli import ExitError, output_folder
+from abstract_map.errors import integer, number, place_name
+from abstract_map.files import json_text, write_text_atomic
 
 SUMMARY = "run one closed-loop trial in a pybullet world (needs the [sim] extra)"
 EXTRA = "sim"  # the optional dependencies it needs
@@ -41,18 +42,29 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--max-sim-s", type=float, default=None, help="cap on simulated seconds (default 900)")
 
 
+def check_arguments(args: argparse.Namespace) -> None:
+    """Every argument checked before any work: ExitError (exit 2) naming the first bad one."""
+    output_folder("--out", args.out)
+    if args.max_sim_s is not None:
+        number("--max-sim-s", args.max_sim_s, low=1.0, high=1e6, error=ExitError)
+    integer("--seed", args.seed, low=0, high=2**32, error=ExitError)
+    place_name("--goal", args.goal, error=ExitError)
+
+
 def run(args: argparse.Namespace) -> int:
     from dataclasses import replace
+
+    from sim.world.data import load_world
+
+    check_arguments(args)  # before the simulator is imported: a bad argument costs nothing
+    world = load_world(args.world)
+    if not world.label_tags(args.goal):
+        raise ExitError(f"--goal {args.goal!r}: no label names it in {world.name}; goals: {sorted(world.goals)}")
 
     from sim.experiments.pictures import animation, trajectory_picture
     from sim.experiments.trial import TrialParams, run_trial
     from sim.navigation.policies import NAVIGATORS
-    from sim.world.data import WorldError, load_world
 
-    try:
-        world = load_world(args.world)
-    except WorldError as exc:
-        raise ExitError(str(exc)) from exc
     if args.navigator not in NAVIGATORS:
         raise ExitError(f"--navigator {args.navigator!r}: expected one of {', '.join(NAVIGATORS)}")
     params = TrialParams()
@@ -75,8 +87,7 @@ def run(args: argparse.Namespace) -> int:
         raise ExitError(str(exc)) from exc
     if live:
         print(file=sys.stderr)
-    args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "result.json").write_text(json.dumps(result.to_dict(), indent=1))
+    write_text_atomic(args.out / "result.json", json_text(result.to_dict(), indent=1))
     trajectory_picture(result, world, args.out / "trajectory.png")
     if args.record:
         animation(result, world, args.out / "run.gif")

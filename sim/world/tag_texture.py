@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-import os
 import tempfile
 from pathlib import Path
+
+from abstract_map.files import atomic_path
 
 
 def tag_png(tag_id: int, *, px_per_cell: int, margin_cells: int, blur_cells: float,
@@ -32,8 +33,7 @@ def tag_png(tag_id: int, *, px_per_cell: int, margin_cells: int, blur_cells: flo
         image = cv2.copyMakeBorder(marker, *(4 * [margin * cell]), cv2.BORDER_CONSTANT, value=255)
         if blur > 0:
             image = cv2.GaussianBlur(image, (0, 0), blur, borderType=cv2.BORDER_REPLICATE)
-        fd, tmp = tempfile.mkstemp(suffix=".png", dir=folder)
-        os.close(fd)
-        cv2.imwrite(tmp, image)
-        os.replace(tmp, path)
+        with atomic_path(path) as tmp:
+            if not cv2.imwrite(str(tmp), image):
+                raise OSError(f"{path}: OpenCV could not write the tag image")
     return path

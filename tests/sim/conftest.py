@@ -86,3 +86,9 @@ def tiny_scene(tiny_world: World):
     scene = build_scene(tiny_world)
     yield scene
     scene.close()
+
+
+@pytest.fixture(scope="session")
+def tiny_world_writer():
+    """:func:`write_world`, for tests that write (and then break) their own copy of the tiny world."""
+    return write_world

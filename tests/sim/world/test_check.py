@@ -129,9 +129,15 @@ def test_command_exit_codes(generated, folder, tmp_path, capsys):
     assert "OK: nothing fails" in capsys.readouterr().out
     broken = tmp_path / "broken"
     shutil.copytree(folder, broken)
-    paint(broken, 0, 0, 100, 100, 0)  # everything wall: nothing can be reached
+    goal = next(iter(json.loads((folder / "world.json").read_text())["oracle_m"]))
+    meta = json.loads((broken / "world.json").read_text())
+    meta["oracle_m"][goal] += 5.0  # a stale oracle: a finding, exit 1
+    (broken / "world.json").write_text(json.dumps(meta))
     assert cli.main(["world", "check", str(broken)]) == 1
-    assert "| start |" in capsys.readouterr().out
+    assert f"goal {goal}" in capsys.readouterr().out
+    paint(broken, 0, 0, 100, 100, 0)  # everything wall: the start is refused at load, one line, exit 2
+    assert cli.main(["world", "check", str(broken)]) == 2
+    assert "start" in capsys.readouterr().err
     assert cli.main(["world", "check", str(tmp_path / "nowhere")]) == 2
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
     out = tmp_path / "new"
