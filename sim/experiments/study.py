@@ -36,6 +36,7 @@ class TrialSpec:
     seed: int
     perception: str
     params: TrialParams
+    log_dir: str | None = None  # folder for a rerun recording of the trial (KEY.rrd), or none
 
     @property
     def key(self) -> str:
@@ -56,7 +57,9 @@ def run_spec(spec: TrialSpec) -> dict[str, Any]:
     try:
         from sim.experiments.trial import run_trial
 
-        result = run_trial(spec.world, spec.goal, seed=spec.seed, perception=spec.perception, params=spec.params)
+        log = None if spec.log_dir is None else Path(spec.log_dir) / f"{spec.key}.rrd"
+        result = run_trial(spec.world, spec.goal, seed=spec.seed, perception=spec.perception, params=spec.params,
+                           log=log)
         return result.to_dict()
     except Exception as exc:  # a failed trial is data, not a crash of the study
         return {"goal": spec.goal, "seed": spec.seed, "perception": spec.perception, "success": False,

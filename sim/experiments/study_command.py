@@ -9,6 +9,7 @@ turning direction and, in geometric mode, detection noise (0.03 m, 1 deg).
 Writes DIR/trials.csv (one row per trial), DIR/report.md (the paper's Table I
 extended with our mean and spread, the oracle and our ratio to it),
 DIR/comparison.png (box plots like the paper's Fig. 11) and DIR/paths/GOAL.png.
+--log also writes a rerun recording of each trial, DIR/trials/GOAL-SEED.rrd.
 A study run again on the same DIR skips the trials already finished there.
 """
 
@@ -38,6 +39,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="local process pool (default) or Ray (needs the [ray] extra)")
     parser.add_argument("--address", help="Ray cluster address (with --executor ray); default: a local Ray")
     parser.add_argument("--out", type=Path, required=True, help="output folder (re-use it to resume)")
+    parser.add_argument("--log", action="store_true",
+                        help="also write a rerun recording of each trial, DIR/trials/GOAL-SEED.rrd (needs [viz])")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -59,6 +62,16 @@ def run(args: argparse.Namespace) -> int:
     except (WorldError, ValueError) as exc:
         raise ExitError(str(exc)) from exc
     specs = plan_specs(world, args.trials, args.perception, goals=args.goals)
+    if args.log:
+        from dataclasses import replace
+
+        from sim.experiments.recording import MissingExtraError, rerun_module
+
+        try:
+            rerun_module()
+        except MissingExtraError as exc:
+            raise ExitError(str(exc)) from exc
+        specs = [replace(spec, log_dir=str(args.out / "trials")) for spec in specs]
     began = time.perf_counter()
     bar = tqdm(total=len(specs), unit="trial", file=sys.stderr, dynamic_ncols=True)
 

@@ -10,6 +10,7 @@ It never waits on anything but the simulator's own steps.
 from __future__ import annotations
 
 import math
+import os
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -276,13 +277,31 @@ class Trial:
 
 def run_trial(world: World | str, goal: str, *, seed: int = 0, perception: str = "camera",
               navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
-              record: bool = False) -> TrialResult:
-    """Run one trial of finding ``goal`` in ``world`` with the navigator driving, and report what happened."""
+              record: bool = False, log: str | os.PathLike[str] | None = None) -> TrialResult:
+    """Run one trial of finding ``goal`` in ``world`` with the navigator driving, and report what happened.
+
+    ``log`` names a rerun recording (.rrd) to write on the simulated-time line (needs the ``viz`` extra;
+    see :mod:`sim.experiments.recording`).
+    """
     with Trial(world, goal, seed=seed, perception=perception, navigator=navigator, params=params,
                progress=progress, record=record) as trial:
-        while not trial.done:
-            trial.step()
-        return trial.result()
+        recorder = None
+        if log is not None:
+            from sim.experiments.recording import Recorder
+
+            recorder = Recorder(trial, log)
+            trial.observers.append(recorder)
+        try:
+            while not trial.done:
+                trial.step()
+            result = trial.result()
+        except BaseException:
+            if recorder is not None:
+                recorder.abandon()
+            raise
+        if recorder is not None:
+            recorder.close(result)
+        return result
 
 
 def _perception_kwargs(mode: str, params: TrialParams) -> dict[str, Any]:
