@@ -237,8 +237,7 @@ class Recorder:
         if target != self.target:
             self.target = target
             rec.log("world/target", rr.Points3D([[*target, 0.1]], radii=0.25, colors=[(220, 0, 0)]))
-        same = (plan is None and self.plan is None) or (
-            plan is not None and self.plan is not None and plan.shape == self.plan.shape and np.array_equal(plan, self.plan))
+        same = (plan is None) == (self.plan is None) and (plan is None or np.array_equal(plan, self.plan))
         if not same:
             self.plan = None if plan is None else plan.copy()
             if plan is None:
