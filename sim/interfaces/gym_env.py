@@ -175,13 +175,11 @@ class FindPlaceEnv(gymnasium.Env):
                 "cues": {s.tag_id: tags[s.tag_id].text for s in trial.sightings if s.tag_id in tags}}
 
     def _build(self, seed: int) -> World:
-        """A generated building from ``seed`` (kept in a folder of this env until it closes)."""
+        """A generated building from ``seed`` (``generator`` gives its style, size, signage), written to a folder
+        of this env's until it closes."""
         if self._generated is None:
             self._generated = Path(tempfile.mkdtemp(prefix="abstract-map-gym-"))
-        root = self._generated / f"seed-{seed}"
-        if root.exists():
-            shutil.rmtree(root)
-        return load_world(self._generate(seed, root=root, **self.generator))
+        return load_world(self._generate(seed, root=self._generated, **self.generator))
 
 
 def _imagined_goal(trial: Trial) -> tuple[float, float]:
