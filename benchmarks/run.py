@@ -10,6 +10,8 @@ scaling  settle time as the model grows: synthetic hierarchies of about 50, 500,
          (a few minutes: the 5,000-place model takes about 13 ms per integration step)
 trials   wall time and real-time factor of the Lion trial, per perception mode
 study    total wall time of a small study (1 trial per goal, geometric, 2 workers)
+recording  what a rerun recording (--log) costs: the Kingfisher trial with and without it, per perception mode
+           (needs the viz extra)
 """
 
 from __future__ import annotations
@@ -131,8 +133,30 @@ def bench_study(trials: int = 1, workers: int = 2, perception: str = "geometric"
           [[str(trials), perception, str(workers), f"{wall:.0f}"]])
 
 
+def bench_recording(goal: str = "Kingfisher") -> None:
+    from sim.experiments.trial import run_trial
+
+    rows = []
+    with tempfile.TemporaryDirectory() as out:
+        for mode in ("geometric", "camera"):
+            runs = {}
+            for log in (None, Path(out) / f"{mode}.rrd"):
+                wall, cpu = time.perf_counter(), time.process_time()
+                result = run_trial(str(ROOT / "worlds" / "zoo"), goal, perception=mode, log=log)
+                runs[log is not None] = (time.perf_counter() - wall, time.process_time() - cpu, result.distance_m)
+            (plain_wall, plain_cpu, plain_m), (log_wall, log_cpu, log_m) = runs[False], runs[True]
+            size = (Path(out) / f"{mode}.rrd").stat().st_size
+            rows.append([mode, goal, f"{plain_m:.1f} / {log_m:.1f}", f"{plain_wall:.1f}", f"{log_wall:.1f}",
+                         f"{100 * (log_wall / plain_wall - 1):+.0f}", f"{100 * (log_cpu / plain_cpu - 1):+.0f}",
+                         f"{size / 1e6:.1f}"])
+    table("Recording a zoo trial (--log): cost and size", ["perception", "goal", "distance without / with (m)",
+                                                            "wall without (s)", "wall with (s)", "wall overhead (%)",
+                                                            "CPU overhead (%)", "file (MB)"], rows)
+
+
 BENCHMARKS: dict[str, Callable[[], None]] = {"settle": bench_settle, "scaling": bench_scaling,
-                                             "trials": bench_trials, "study": bench_study}
+                                             "trials": bench_trials, "study": bench_study,
+                                             "recording": bench_recording}
 
 
 def main() -> int:

@@ -9,14 +9,16 @@ rate), tags are read at the perception rate (other steps report none).
   robot holds to its limits (0.4 m/s, 0.4 rad/s) whatever the wheels are asked.
 - observation: see :mod:`sim.interfaces.observation`.
 - reward: minus the metres driven this step, plus ``goal_bonus`` on the step the goal's label is read.
-- ``terminated`` when the goal's label is read; ``truncated`` at the cap on simulated time (or distance).
+- ``terminated`` when the goal's label is read (on the first step, when it is read from the start);
+  ``truncated`` at the cap on simulated time (or distance).
 - ``reset(seed=...)`` picks the goal (when not given) and seeds the trial's variation; with ``world="generated"``
   it also builds a building from the seed. The same seed gives the same episode.
 - ``render_mode="rgb_array"``: the trial's picture so far (floor plan, path, tags read, imagined places).
 
-The environment's own abstract map keeps listening to the tags read, so ``goal``
-follows the cues whoever drives; its exploration grows only when our navigator
-drives (an agent's arrival at the imagined goal is not judged). Tag ids index
+The environment's own abstract map listens to the tags read, so ``goal``
+follows the cues whoever drives; its exploration factor never grows (no one
+judges an agent's arrival at the imagined goal; our navigator as a policy keeps
+its own abstract map, which does). Tag ids index
 the world's tag table (``env.unwrapped.world.tags``); ``info["cues"]`` gives the
 text of the tags read this step.
 """

@@ -63,3 +63,15 @@ def test_the_trial_command_logs_and_names_the_missing_extra(tiny_world, tmp_path
     monkeypatch.setattr(recording, "rerun_module", missing)
     assert main(args) == 2
     assert 'abstract-map[viz]' in capsys.readouterr().err
+
+
+def test_a_study_trial_writes_its_recording(tiny_world, tmp_path):
+    pytest.importorskip("rerun")
+    from dataclasses import replace
+
+    from sim.experiments.study import plan_specs, run_spec
+
+    spec = replace(plan_specs(tiny_world, 1, "geometric")[0], log_dir=str(tmp_path))
+    assert run_spec(spec)["success"]
+    assert [p.name for p in tmp_path.iterdir()] == [f"{spec.key}.rrd"]
+    assert "world/robot" in entities(tmp_path / f"{spec.key}.rrd")
