@@ -127,14 +127,37 @@ def test_bad_arguments_are_errors(tiny_world):
         env.step(np.zeros(2))
 
 
-def test_generated_worlds_need_the_generator():
+def has_generator() -> bool:
     try:
         import sim.world.generator  # noqa: F401
-    except ModuleNotFoundError:
-        with pytest.raises(ValueError, match="generator"):
-            FindPlaceEnv("generated")
-    else:
-        pytest.skip("the generator is here: see the generated-world test")
+    except ModuleNotFoundError as exc:
+        if exc.name != "sim.world.generator":
+            raise
+        return False
+    return True
+
+
+def test_generated_worlds_need_the_generator():
+    if has_generator():
+        pytest.skip("the generator is here: see test_the_seed_builds_the_generated_building")
+    with pytest.raises(ValueError, match="generator"):
+        FindPlaceEnv("generated")
+
+
+def test_the_seed_builds_the_generated_building():
+    if not has_generator():
+        pytest.skip("no building generator (sim.world.generator) in this version")
+    env = gymnasium.make(MAKE_ID, world="generated", perception="geometric", generator={"size": "small"})
+    try:
+        first, info = env.reset(seed=3)
+        name = env.unwrapped.trial.world.name
+        again, info_again = env.reset(seed=3)
+        assert env.unwrapped.trial.world.name == name and info_again["goal"] == info["goal"]
+        assert np.array_equal(first["laser"], again["laser"]) and np.array_equal(first["goal"], again["goal"])
+        env.reset(seed=4)
+        assert env.unwrapped.trial.world.name != name
+    finally:
+        env.close()
 
 
 @pytest.mark.slow
