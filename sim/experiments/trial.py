@@ -122,6 +122,18 @@ def _start_pose(world: World, params: TrialParams, rng: np.random.Generator) -> 
             theta + math.radians(rng.normal(0.0, params.start_jitter_deg)) if params.start_jitter_deg else theta)
 
 
+def occupancy_grid(world: World, params: TrialParams) -> OccupancyGrid:
+    """An empty occupancy grid over the world's floor plan (every cell unknown)."""
+    x0, x1, y0, y1 = world.floorplan.extent
+    return OccupancyGrid(OccupancyParams(resolution_m=params.occupancy_resolution_m, bounds=(x0, x1, y0, y1)))
+
+
+def policy_params(params: TrialParams) -> PolicyParams:
+    """The slice of the trial's parameters a navigation policy is built from."""
+    return PolicyParams(params.navigator, params.planner, params.replan, params.follower, params.targeting,
+                        params.target_recheck_s)
+
+
 Observer = Callable[["Trial"], None]
 """Called after every control tick with the trial (for recordings); must not change it."""
 
@@ -160,13 +172,10 @@ class Trial:
         except BaseException:
             scene.close()
             raise
-        x0, x1, y0, y1 = self.world.floorplan.extent
-        self.grid = OccupancyGrid(OccupancyParams(resolution_m=params.occupancy_resolution_m, bounds=(x0, x1, y0, y1)))
+        self.grid = occupancy_grid(self.world, params)
         self.angles = laser_angles(params.laser)
         self.navigator = navigator
-        self.policy = make_policy(navigator, self.world, goal, self.start, PolicyParams(
-            params.navigator, params.planner, params.replan, params.follower, params.targeting,
-            params.target_recheck_s))
+        self.policy = make_policy(navigator, self.world, goal, self.start, policy_params(params))
         self.goal_tags = {tag.id for tag in self.world.tags.values()
                           if tag.kind == "label" and tag.text.casefold() == goal.casefold()}
         self.success = False

@@ -14,10 +14,9 @@ from typing import Any
 
 import numpy as np
 
-from sim.experiments.trial import TrialParams
+from sim.experiments.trial import TrialParams, occupancy_grid, policy_params
 from sim.interfaces.observation import decode_sightings
-from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
-from sim.navigation.policies import Policy, PolicyParams, make_policy
+from sim.navigation.policies import Policy, make_policy
 from sim.perception.laser import laser_angles
 from sim.world.data import World
 from sim.world.robot import RobotParams
@@ -32,8 +31,7 @@ class NavigatorPolicy:
         self.action, self.tick_s = action, tick_s
         self.robot = RobotParams()
         self.rng = np.random.default_rng(seed)
-        x0, x1, y0, y1 = world.floorplan.extent
-        self.grid = OccupancyGrid(OccupancyParams(resolution_m=params.occupancy_resolution_m, bounds=(x0, x1, y0, y1)))
+        self.grid = occupancy_grid(world, params)
         self.angles = laser_angles(params.laser)
         self.policy: Policy | None = None
         self.t = 0.0  # s of simulated time
@@ -46,8 +44,7 @@ class NavigatorPolicy:
         pose = (float(pose_array[0]), float(pose_array[1]), float(pose_array[2]))
         prm = self.params
         if self.policy is None:
-            self.policy = make_policy(self.navigator, self.world, self.goal, pose, PolicyParams(
-                prm.navigator, prm.planner, prm.replan, prm.follower, prm.targeting, prm.target_recheck_s))
+            self.policy = make_policy(self.navigator, self.world, self.goal, pose, policy_params(prm))
         else:
             self.t += self.tick_s
             self.distance += float(np.hypot(*(pose_array[:2] - self.last[:2])))  # type: ignore[index]
