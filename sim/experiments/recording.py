@@ -112,6 +112,8 @@ class Recorder:
         every = {name: max(1, round(s / trial.tick)) for name, s in
                  (("path", prm.path_every_s), ("grid", prm.grid_every_s), ("plan", prm.plan_every_s))}
         self.every = every
+        self.poses: list[tuple[float, float, float, float]] = []  # (t s, x m, y m, theta rad) not yet sent
+        self.scans: list[tuple[float, np.ndarray]] = []  # (t s, hits (N, 3) m, robot frame) not yet sent
         self.cues = 0
         self.settles = -1
         self.plan: np.ndarray | None = None
@@ -134,21 +136,21 @@ class Recorder:
         robot = trial.robot.params
         rec.log("world/robot/body", rr.Boxes3D(half_sizes=[[robot.length / 2, robot.width / 2, 0.675]],
                                                centers=[[0.0, 0.0, 0.675]], colors=[(31, 119, 180)]), static=True)
+        rec.log("world/robot/laser", rr.Points3D.from_fields(radii=0.03, colors=[(230, 30, 30)]), static=True)
 
     def __call__(self, trial: Trial) -> None:
         """Log the trial's state after a control tick (or at its start)."""
         rr, rec, n = self.rr, self.rec, trial.n
         rec.set_time(TIMELINE, duration=trial.t)
         x, y, theta = trial.last
-        rec.log("world/robot", rr.Transform3D(translation=[x, y, 0.0], rotation_axis_angle=rr.RotationAxisAngle(
-            axis=[0.0, 0.0, 1.0], radians=theta)))
+        self.poses.append((trial.t, x, y, theta))
         if n % trial.every["map"] == 0 and trial.scan is not None:
             hit = trial.scan < trial.params.laser.max_range_m - 1e-6
             r, a = trial.scan[hit], trial.angles[hit]
             z = np.full(r.shape, trial.params.laser.height_m)
-            rec.log("world/robot/laser", rr.Points3D(np.stack([r * np.cos(a), r * np.sin(a), z], axis=1),
-                                                     radii=0.03, colors=[(230, 30, 30)]))
+            self.scans.append((trial.t, np.stack([r * np.cos(a), r * np.sin(a), z], axis=1)))
         if n % self.every["path"] == 0 or trial.done:
+            self._send_motion()
             path = np.array([row[1:3] for row in trial.trajectory] + [(x, y)])
             rec.log("world/path", rr.LineStrips3D([np.hstack([path, np.full((len(path), 1), 0.03)])],
                                                   radii=0.04, colors=[(31, 119, 180)]))
@@ -165,6 +167,23 @@ class Recorder:
         self._model(trial)
         if n % self.every["plan"] == 0 or trial.done:
             self._plan(trial)
+
+    def _send_motion(self) -> None:
+        """The poses and scans gathered since the last call, as columns (one call, not one per tick)."""
+        rr, rec = self.rr, self.rec
+        if self.poses:
+            t, x, y, theta = np.array(self.poses).T
+            zeros = np.zeros_like(t)
+            rec.send_columns("world/robot", indexes=[rr.TimeColumn(TIMELINE, duration=t)],
+                             columns=rr.Transform3D.columns(
+                                 translation=np.stack([x, y, zeros], axis=1),
+                                 quaternion=np.stack([zeros, zeros, np.sin(theta / 2), np.cos(theta / 2)], axis=1)))
+            self.poses = []
+        if self.scans:
+            times, hits = zip(*self.scans)
+            columns = rr.Points3D.columns(positions=np.vstack(hits)).partition([len(h) for h in hits])
+            rec.send_columns("world/robot/laser", indexes=[rr.TimeColumn(TIMELINE, duration=times)], columns=columns)
+            self.scans = []
 
     def _camera(self, trial: Trial) -> None:
         sweep = getattr(trial.sensor, "last_sweep", None)
@@ -253,6 +272,7 @@ class Recorder:
 
     def close(self, result: TrialResult | None = None) -> Path:
         """Log the verdict, finish the file and move it into place; returns its path."""
+        self._send_motion()
         if result is not None:
             verdict = "FOUND" if result.success else f"FAILED ({result.reason})"
             self.rec.log("events", self.rr.TextLog(f"{result.goal}: {verdict} after {result.distance_m:.1f} m, "
