@@ -134,7 +134,10 @@ def bench_study(trials: int = 1, workers: int = 2, perception: str = "geometric"
 
 
 def bench_recording(goal: str = "Kingfisher") -> None:
+    from sim.experiments.recording import rerun_module
     from sim.experiments.trial import run_trial
+
+    rerun_module()  # imported before the clocks start
 
     rows = []
     with tempfile.TemporaryDirectory() as out:
