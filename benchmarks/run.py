@@ -17,6 +17,8 @@ generalise  test buildings (seeds 1000-1049, styles and signage levels cycling),
          perception, navigators paper and frontier; then 10 of them (1000-1009) with the camera and the paper
          navigator. Success, SPL, ratio to oracle and wall time per navigator and signage level, and per style.
          A resumable study folder (--out, default runs/generalise); named only, never part of the default set.
+recording  what a rerun recording (--log) costs: the Kingfisher trial with and without it, per perception mode
+           (needs the viz extra)
 """
 
 from __future__ import annotations
@@ -236,11 +238,33 @@ def bench_generate(seeds: range = range(1000, 1005)) -> None:
                          f"{min(rooms)}-{max(rooms)}", f"{min(tags)}-{max(tags)}", f"{passed}/{len(seeds)}"])
     table("Generate", ["size", "style", "median CPU (s)", "max CPU (s)", "median wall (s)", "rooms", "tags",
                        "pass world check"], rows)
+def bench_recording(goal: str = "Kingfisher") -> None:
+    from sim.experiments.recording import rerun_module
+    from sim.experiments.trial import run_trial
+
+    rerun_module()  # imported before the clocks start
+
+    rows = []
+    with tempfile.TemporaryDirectory() as out:
+        for mode in ("geometric", "camera"):
+            runs = {}
+            for log in (None, Path(out) / f"{mode}.rrd"):
+                wall, cpu = time.perf_counter(), time.process_time()
+                result = run_trial(str(ROOT / "worlds" / "zoo"), goal, perception=mode, log=log)
+                runs[log is not None] = (time.perf_counter() - wall, time.process_time() - cpu, result.distance_m)
+            (plain_wall, plain_cpu, plain_m), (log_wall, log_cpu, log_m) = runs[False], runs[True]
+            size = (Path(out) / f"{mode}.rrd").stat().st_size
+            rows.append([mode, goal, f"{plain_m:.1f} / {log_m:.1f}", f"{plain_wall:.1f}", f"{log_wall:.1f}",
+                         f"{100 * (log_wall / plain_wall - 1):+.0f}", f"{100 * (log_cpu / plain_cpu - 1):+.0f}",
+                         f"{size / 1e6:.1f}"])
+    table("Recording a zoo trial (--log): cost and size", ["perception", "goal", "distance without / with (m)",
+                                                            "wall without (s)", "wall with (s)", "wall overhead (%)",
+                                                            "CPU overhead (%)", "file (MB)"], rows)
 
 
 BENCHMARKS: dict[str, Callable[[], None]] = {"settle": bench_settle, "scaling": bench_scaling,
                                              "trials": bench_trials, "study": bench_study,
-                                             "generate": bench_generate}
+                                             "generate": bench_generate, "recording": bench_recording}
 NAMED_ONLY = ("generalise",)  # too long for the default set; run by name
 
 

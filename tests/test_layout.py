@@ -1,5 +1,6 @@
 """The layout follows the data flow: the core never names the simulator, and the simulator's packages
-import only packages before them (world -> perception -> mapping -> navigation -> experiments)."""
+import only packages before them (world -> perception -> mapping -> navigation -> experiments
+-> interfaces)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-FLOW = ("world", "perception", "mapping", "navigation", "experiments")
+FLOW = ("world", "perception", "mapping", "navigation", "experiments", "interfaces")
 
 
 def imported_modules(path: Path, package: str) -> set[str]:

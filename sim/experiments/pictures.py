@@ -71,6 +71,24 @@ def draw_places(ax: Axes, places: dict[str, tuple[float, float]], goal: str | No
 def trajectory_picture(result: TrialResult, world: World, path: str | os.PathLike[str]) -> None:
     """Floor plan, the robot's path, the tags it read, and the final imagined places."""
     plt = _pyplot()
+    fig = _trajectory_figure(plt, result, world)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+
+
+def trajectory_image(result: TrialResult, world: World, *, dpi: int = 60) -> np.ndarray:
+    """The picture of :func:`trajectory_picture` as an RGB array (rows, cols, 3) uint8."""
+    plt = _pyplot()
+    fig = _trajectory_figure(plt, result, world)
+    fig.set_dpi(dpi)
+    fig.canvas.draw()
+    image = np.asarray(fig.canvas.buffer_rgba())[:, :, :3].copy()
+    plt.close(fig)
+    return image
+
+
+def _trajectory_figure(plt: Any, result: TrialResult, world: World) -> Any:
     fig, ax = plt.subplots(figsize=(12, 7.5))
     draw_floorplan(ax, world)
     goal_tags = [t.id for t in world.label_tags(result.goal)]
@@ -85,9 +103,7 @@ def trajectory_picture(result: TrialResult, world: World, path: str | os.PathLik
                  f"{result.distance_m:.1f} m, {len(result.cues)} cues")
     ax.legend(loc="lower right")
     fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
+    return fig
 
 
 def animation(result: TrialResult, world: World, path: str | os.PathLike[str], *, fps: int = 8) -> None:

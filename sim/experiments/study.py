@@ -67,6 +67,7 @@ class TrialSpec:
     @property
     def name(self) -> str:
         return self.world_name or Path(self.world).name
+    log_dir: str | None = None  # folder for a rerun recording of the trial (KEY.rrd), or none
 
     @property
     def key(self) -> str:
@@ -90,8 +91,9 @@ def run_spec(spec: TrialSpec) -> dict[str, Any]:
     try:
         from sim.experiments.trial import run_trial
 
+        log = None if spec.log_dir is None else Path(spec.log_dir) / f"{spec.key}.rrd"
         result = run_trial(spec.world, spec.goal, seed=spec.seed, perception=spec.perception,
-                           navigator=spec.navigator, params=spec.params)
+                           navigator=spec.navigator, params=spec.params, log=log)
         record = result.to_dict()
     except Exception as exc:  # a failed trial is data, not a crash of the study
         record = {"goal": spec.goal, "seed": spec.seed, "perception": spec.perception, "success": False,

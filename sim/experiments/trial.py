@@ -10,6 +10,7 @@ It never waits on anything but the simulator's own steps.
 from __future__ import annotations
 
 import math
+import os
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -124,6 +125,18 @@ def _start_pose(world: World, params: TrialParams, rng: np.random.Generator) -> 
             theta + math.radians(rng.normal(0.0, params.start_jitter_deg)) if params.start_jitter_deg else theta)
 
 
+def occupancy_grid(world: World, params: TrialParams) -> OccupancyGrid:
+    """An empty occupancy grid over the world's floor plan (every cell unknown)."""
+    x0, x1, y0, y1 = world.floorplan.extent
+    return OccupancyGrid(OccupancyParams(resolution_m=params.occupancy_resolution_m, bounds=(x0, x1, y0, y1)))
+
+
+def policy_params(params: TrialParams) -> PolicyParams:
+    """The slice of the trial's parameters a navigation policy is built from."""
+    return PolicyParams(params.navigator, params.planner, params.replan, params.follower, params.targeting,
+                        params.target_recheck_s)
+
+
 Observer = Callable[["Trial"], None]
 """Called after every control tick with the trial (for recordings); must not change it."""
 
@@ -164,13 +177,10 @@ class Trial:
         except BaseException:
             scene.close()
             raise
-        x0, x1, y0, y1 = self.world.floorplan.extent
-        self.grid = OccupancyGrid(OccupancyParams(resolution_m=params.occupancy_resolution_m, bounds=(x0, x1, y0, y1)))
+        self.grid = occupancy_grid(self.world, params)
         self.angles = laser_angles(params.laser)
         self.navigator = navigator
-        self.policy = make_policy(navigator, self.world, goal, self.start, PolicyParams(
-            params.navigator, params.planner, params.replan, params.follower, params.targeting,
-            params.target_recheck_s))
+        self.policy = make_policy(navigator, self.world, goal, self.start, policy_params(params))
         self.goal_tags = {tag.id for tag in self.world.tags.values()
                           if tag.kind == "label" and tag.text.casefold() == goal.casefold()}
         self.success = False
@@ -281,13 +291,31 @@ class Trial:
 
 def run_trial(world: World | str, goal: str, *, seed: int = 0, perception: str = "camera",
               navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
-              record: bool = False) -> TrialResult:
-    """Run one trial of finding ``goal`` in ``world`` with the navigator driving, and report what happened."""
+              record: bool = False, log: str | os.PathLike[str] | None = None) -> TrialResult:
+    """Run one trial of finding ``goal`` in ``world`` with the navigator driving, and report what happened.
+
+    ``log`` names a rerun recording (.rrd) to write on the simulated-time line (needs the ``viz`` extra;
+    see :mod:`sim.experiments.recording`).
+    """
     with Trial(world, goal, seed=seed, perception=perception, navigator=navigator, params=params,
                progress=progress, record=record) as trial:
-        while not trial.done:
-            trial.step()
-        return trial.result()
+        recorder = None
+        if log is not None:
+            from sim.experiments.recording import Recorder
+
+            recorder = Recorder(trial, log)
+            trial.observers.append(recorder)
+        try:
+            while not trial.done:
+                trial.step()
+            result = trial.result()
+        except BaseException:
+            if recorder is not None:
+                recorder.abandon()
+            raise
+        if recorder is not None:
+            recorder.close(result)
+        return result
 
 
 def _perception_kwargs(mode: str, params: TrialParams) -> dict[str, Any]:

@@ -4,13 +4,15 @@ Example:
   abstract-map trial --world zoo --goal Lion --out runs/lion
   abstract-map trial --world zoo --goal Toilets --perception geometric --seed 3 --out runs/t3 --record
   abstract-map trial --world zoo --goal Lion --navigator frontier --perception geometric --out runs/f
+  abstract-map trial --world zoo --goal Kingfisher --out runs/k --log runs/k/run.rrd   (then: rerun runs/k/run.rrd)
 
 Prints a live progress line (simulated time, distance, cues read), then writes
 DIR/result.json (goal, success, reason, distance_m, simulated and wall seconds,
 cues read in order with the distance at each, the trajectory) and
 DIR/trajectory.png (floor plan, path, tags read, final imagined places).
 --record also writes DIR/run.gif, an animation of the robot, the explored map
-and the abstract map. Exit code 0 when the goal was found, 1 when the trial
+and the abstract map. --log FILE.rrd writes a rerun recording on the
+simulated-time line (needs the [viz] extra). Exit code 0 when the goal was found, 1 when the trial
 failed (the reason is in result.json), 2 on bad input.
 """
 
@@ -39,6 +41,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "(nearest frontier, reads no sign: the no-signs lower bound)")
     parser.add_argument("--out", type=Path, required=True, help="output folder")
     parser.add_argument("--record", action="store_true", help="also write DIR/run.gif, an animation of the run")
+    parser.add_argument("--log", type=Path, metavar="FILE.rrd",
+                        help="also write a rerun recording of the run (open it with: rerun FILE.rrd; needs [viz])")
     parser.add_argument("--max-sim-s", type=float, default=None, help="cap on simulated seconds (default 900)")
 
 
@@ -62,11 +66,17 @@ def run(args: argparse.Namespace) -> int:
         raise ExitError(f"--goal {args.goal!r}: no label names it in {world.name}; goals: {sorted(world.goals)}")
 
     from sim.experiments.pictures import animation, trajectory_picture
+    from sim.experiments.recording import MissingExtraError, rerun_module
     from sim.experiments.trial import TrialParams, run_trial
     from sim.navigation.policies import NAVIGATORS
 
     if args.navigator not in NAVIGATORS:
         raise ExitError(f"--navigator {args.navigator!r}: expected one of {', '.join(NAVIGATORS)}")
+    if args.log is not None:
+        try:
+            rerun_module()
+        except MissingExtraError as exc:
+            raise ExitError(str(exc)) from exc
     params = TrialParams()
     if args.max_sim_s is not None:
         params = replace(params, max_sim_s=args.max_sim_s)
@@ -82,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         result = run_trial(world, args.goal, seed=args.seed, perception=args.perception,
                            navigator=args.navigator, params=params,
-                           progress=progress, record=args.record)
+                           progress=progress, record=args.record, log=args.log)
     except ValueError as exc:
         raise ExitError(str(exc)) from exc
     if live:

@@ -18,7 +18,7 @@ the world as x -> (sin psi, -cos psi, 0), y -> (0, 0, -1), z -> (cos psi, sin ps
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import MappingProxyType
 
 import cv2
@@ -148,6 +148,16 @@ class Detection:
     z: float  # m, world frame
     theta: float  # rad, world yaw of the tag's outward normal
     off_centre: float  # |u - cx| / width, 0 at the view's centre column
+    corners_px: np.ndarray | None = field(default=None, compare=False)  # (4, 2) refined corners (u, v), px
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """One panoramic sweep as the camera saw it (the latest is kept, by reference, for recordings)."""
+
+    images: dict[int, np.ndarray]  # view index -> grey image (height_px, width_px) uint8, rendered views only
+    detections: dict[int, list[Detection]]  # view index -> every tag found in it, before the reading rules
+    read: frozenset[int]  # ids that passed the reading rules (the sweep's sightings)
 
 
 class CameraPerception:
@@ -167,6 +177,7 @@ class CameraPerception:
             raise ValueError(f"CameraParams: need n_views >= 1 and images >= 8 px, got {prm}")
         self.scene = scene
         self.params = prm
+        self.last_sweep: Sweep | None = None  # the latest sweep's images and detections
         self._rng = rng  # unused: rendering is deterministic; kept for a uniform constructor
         detector_params = cv2.aruco.DetectorParameters()
         detector_params.cornerRefinementMethod = _REFINEMENT[prm.corner_refinement]
@@ -264,7 +275,7 @@ class CameraPerception:
             u = float(pixels[:, 0].mean())
             found.append(Detection(int(tag_id), float(centre[0]), float(centre[1]), float(centre[2]),
                                    math.atan2(normal[1], normal[0]),
-                                   abs(u - self.intrinsics[0, 2]) / self.params.width_px))
+                                   abs(u - self.intrinsics[0, 2]) / self.params.width_px, pixels))
         return found
 
     def _project(self, t: np.ndarray, angle: float) -> np.ndarray:
@@ -337,8 +348,11 @@ class CameraPerception:
         x, y, z, yaw = robot.camera_pose()
         best: dict[int, Detection] = {}
         views = self.views_to_render(x, y, yaw) if prm.skip_empty_views else None
-        for k, image in self.render(x, y, z, yaw, views).items():
-            for det in self.detect(image, x, y, z, yaw + k * math.tau / prm.n_views):
+        images = self.render(x, y, z, yaw, views)
+        found: dict[int, list[Detection]] = {}
+        for k, image in images.items():
+            found[k] = self.detect(image, x, y, z, yaw + k * math.tau / prm.n_views)
+            for det in found[k]:
                 if det.tag_id not in self.scene.world.tags:
                     continue
                 if not readable(x, y, det.x, det.y, det.theta, max_range_m=prm.max_range_m,
@@ -347,4 +361,5 @@ class CameraPerception:
                 if det.tag_id not in best or det.off_centre < best[det.tag_id].off_centre:
                     best[det.tag_id] = det
         sightings = [Sighting(d.tag_id, d.x, d.y, d.theta, math.hypot(d.x - x, d.y - y)) for d in best.values()]
+        self.last_sweep = Sweep(images, found, frozenset(best))
         return sorted(sightings, key=lambda s: s.range_m)
