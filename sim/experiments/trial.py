@@ -18,12 +18,14 @@ from typing import Any
 import numpy as np
 
 from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
+from sim.navigation.belief import BeliefParams
 from sim.navigation.follower import FollowerParams
 from sim.navigation.navigator import CueEvent, NavigatorParams
 from sim.navigation.planner import PlannerParams
 from sim.navigation.policies import PolicyParams, make_policy
 from sim.navigation.replanner import ReplanParams
 from sim.navigation.targeting import TargetParams
+from sim.navigation.viewpoints import ViewpointParams
 from sim.perception import GeometricParams, Sighting, make_perception
 from sim.perception.laser import LaserParams, laser_angles, scan
 from sim.world.data import World, load_world
@@ -54,6 +56,8 @@ class TrialParams:
     follower: FollowerParams = field(default_factory=FollowerParams)
     targeting: TargetParams = field(default_factory=TargetParams)
     target_recheck_s: float = 5.0  # s between re-choosing the target when the model has not changed
+    belief: BeliefParams = field(default_factory=BeliefParams)  # the viewpoint navigator's goal belief and sweep
+    viewpoints: ViewpointParams = field(default_factory=ViewpointParams)  # ... and how it values viewpoints
     laser: LaserParams = field(default_factory=LaserParams)
     occupancy_resolution_m: float = 0.1  # m, grid cell
 
@@ -165,7 +169,7 @@ class Trial:
         self.navigator = navigator
         self.policy = make_policy(navigator, self.world, goal, self.start, PolicyParams(
             params.navigator, params.planner, params.replan, params.follower, params.targeting,
-            params.target_recheck_s))
+            params.target_recheck_s, params.belief, params.viewpoints))
         self.goal_tags = {tag.id for tag in self.world.tags.values()
                           if tag.kind == "label" and tag.text.casefold() == goal.casefold()}
         self.success = False
