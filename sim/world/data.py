@@ -22,7 +22,7 @@ TAG_KINDS = ("label", "sign", "empty")
 
 _WORLD_KEYS = {
     "format", "name", "title", "floorplan", "tags", "hierarchy", "start",
-    "goals", "tag", "walls", "licence",
+    "goals", "tag", "walls", "licence", "oracle_m", "generator",
 }
 _FLOORPLAN_KEYS = {"image", "resolution_m", "origin_m", "occupied_thresh", "free_thresh", "negate"}
 _TAG_KEYS = {"id", "x_m", "y_m", "theta_deg", "kind", "text"}
@@ -121,6 +121,8 @@ class World:
     wall_height: float = 2.0  # m
     licence: str | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    oracle_m: dict[str, float] | None = None  # m, per goal: the oracle's path length from the start, if stored
+    generator: dict[str, Any] | None = None  # how a generated world was made (seed, style, ...), see worlds/README.md
 
     def label_tags(self, place: str) -> list[Tag]:
         """The label tags that mark ``place``."""
@@ -165,6 +167,18 @@ def _load_tags(path: Path) -> dict[int, Tag]:
             raise WorldError(f"{where}: duplicate tag id {tag.id}")
         tags[tag.id] = tag
     return tags
+
+
+def _load_oracle(spec: Any, goals: dict[str, int]) -> dict[str, float] | None:
+    if spec is None:
+        return None
+    if not isinstance(spec, dict):
+        raise WorldError(f"world.json oracle_m: expected a mapping goal -> metres, got {spec!r}")
+    for goal, length in spec.items():
+        if goal not in goals:
+            raise WorldError(f"world.json oracle_m: {goal!r} is not a goal; goals are {sorted(goals)}")
+        _finite(f"world.json oracle_m {goal!r}", length)
+    return {str(k): float(v) for k, v in spec.items()}
 
 
 def worlds_dir() -> Path:
@@ -225,4 +239,6 @@ def load_world(name_or_path: str | os.PathLike[str]) -> World:
         tag_height=float(tag_spec.get("height_m", 1.1)),
         wall_height=float(meta.get("walls", {}).get("height_m", 2.0)),
         licence=meta.get("licence"),
+        oracle_m=_load_oracle(meta.get("oracle_m"), goals),
+        generator=meta.get("generator"),
     )

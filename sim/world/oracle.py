@@ -40,13 +40,18 @@ class OraclePath:
 
 
 def pooled_floorplan(world: World, cell_m: float) -> Floorplan:
-    """The floor plan max-pooled to cells of about ``cell_m`` (m); the origin is unchanged."""
-    factor = max(1, round(cell_m / world.floorplan.resolution))
-    occ = world.floorplan.occupied
+    """The world's floor plan max-pooled to cells of about ``cell_m`` (m); the origin is unchanged."""
+    return pool_plan(world.floorplan, cell_m)
+
+
+def pool_plan(plan: Floorplan, cell_m: float) -> Floorplan:
+    """``plan`` max-pooled to cells of about ``cell_m`` (m); the origin is unchanged."""
+    factor = max(1, round(cell_m / plan.resolution))
+    occ = plan.occupied
     rows, cols = (occ.shape[0] // factor) * factor, (occ.shape[1] // factor) * factor
     occ = occ[occ.shape[0] - rows:, :cols]  # crop from the top, keeping the bottom-left origin
     pooled = occ.reshape(rows // factor, factor, cols // factor, factor).any(axis=(1, 3))
-    return Floorplan(pooled, world.floorplan.resolution * factor, world.floorplan.origin)
+    return Floorplan(pooled, plan.resolution * factor, plan.origin)
 
 
 def readable_cells(plan: Floorplan, tag: Tag, params: OracleParams) -> np.ndarray:
@@ -87,35 +92,65 @@ def readable_cells(plan: Floorplan, tag: Tag, params: OracleParams) -> np.ndarra
     return mask
 
 
+def free_cells(plan: Floorplan, robot_radius_m: float) -> np.ndarray:
+    """Boolean mask over ``plan`` of cells where the robot's centre fits: farther than its radius from any wall."""
+    return ndimage.distance_transform_edt(~plan.occupied) * plan.resolution > robot_radius_m
+
+
+def distance_field(free: np.ndarray, sources: list[tuple[int, int]]) -> tuple[np.ndarray, MCP_Geometric]:
+    """Shortest 8-connected path lengths (cells, exact diagonals) over ``free`` from the nearest of ``sources``.
+
+    Returns the cumulative cost (inf where unreachable) and the searcher,
+    whose ``traceback(cell)`` gives the path from the nearest source to ``cell``.
+    """
+    mcp = MCP_Geometric(np.where(free, 1.0, np.inf))
+    cumulative, _ = mcp.find_costs(sources)
+    return cumulative, mcp
+
+
+def nearest_cell(cumulative: np.ndarray, mask: np.ndarray) -> tuple[float, tuple[int, int]] | None:
+    """The cheapest reachable cell of ``mask`` and its cost (cells), or None when none is reachable."""
+    cells = np.argwhere(mask)
+    if len(cells) == 0:
+        return None
+    costs = cumulative[cells[:, 0], cells[:, 1]]
+    i = int(np.argmin(costs))
+    if not np.isfinite(costs[i]):
+        return None
+    return float(costs[i]), (int(cells[i, 0]), int(cells[i, 1]))
+
+
 def oracle_path(world: World, goal: str, start: tuple[float, float] | None = None,
                 params: OracleParams | None = None) -> OraclePath:
     """Shortest path from ``start`` (default: the world's start) to read ``goal``'s label."""
+    return oracle_paths(world, [goal], start, params)[goal]
+
+
+def oracle_paths(world: World, goals: list[str], start: tuple[float, float] | None = None,
+                 params: OracleParams | None = None) -> dict[str, OraclePath]:
+    """:func:`oracle_path` for several goals, searching the floor plan once."""
     params = params or OracleParams()
-    tags = world.label_tags(goal)
-    if not tags:
-        raise ValueError(f"goal {goal!r}: no label tag in world {world.name!r}")
+    for goal in goals:
+        if not world.label_tags(goal):
+            raise ValueError(f"goal {goal!r}: no label tag in world {world.name!r}")
     grid = pooled_floorplan(world, params.cell_m)
-    free = ndimage.distance_transform_edt(~grid.occupied) * grid.resolution > params.robot_radius_m
-    costs = np.where(free, 1.0, np.inf)
+    free = free_cells(grid, params.robot_radius_m)
     start_xy = np.array(start if start is not None else world.start[:2], dtype=float)
     start_rc = tuple(grid.world_to_pixel(start_xy)[0])
     if not free[start_rc]:
         raise ValueError(f"oracle: the start {tuple(start_xy)} is within the robot's radius of a wall")
-    mcp = MCP_Geometric(costs)
-    cumulative, _ = mcp.find_costs([start_rc])
-    best: tuple[float, Tag, tuple[int, int]] | None = None
-    for tag in tags:
-        readable = readable_cells(grid, tag, params) & free
-        if not readable.any():
-            continue
-        cells = np.argwhere(readable)
-        costs_here = cumulative[cells[:, 0], cells[:, 1]]
-        i = int(np.argmin(costs_here))
-        if np.isfinite(costs_here[i]) and (best is None or costs_here[i] < best[0]):
-            best = (float(costs_here[i]), tag, (int(cells[i, 0]), int(cells[i, 1])))
-    if best is None:
-        raise ValueError(f"oracle: no reachable pose reads the label of {goal!r}")
-    cost, tag, end = best
-    path = grid.pixel_to_world(np.array(mcp.traceback(end)))
-    length = float(np.hypot(*np.diff(path, axis=0).T).sum())
-    return OraclePath(goal, tag.id, length, path)
+    cumulative, mcp = distance_field(free, [start_rc])
+    paths: dict[str, OraclePath] = {}
+    for goal in goals:
+        best: tuple[float, Tag, tuple[int, int]] | None = None
+        for tag in world.label_tags(goal):
+            found = nearest_cell(cumulative, readable_cells(grid, tag, params) & free)
+            if found is not None and (best is None or found[0] < best[0]):
+                best = (found[0], tag, found[1])
+        if best is None:
+            raise ValueError(f"oracle: no reachable pose reads the label of {goal!r}")
+        _, tag, end = best
+        path = grid.pixel_to_world(np.array(mcp.traceback(end)))
+        length = float(np.hypot(*np.diff(path, axis=0).T).sum())
+        paths[goal] = OraclePath(goal, tag.id, length, path)
+    return paths
