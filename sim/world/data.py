@@ -189,7 +189,7 @@ def worlds_dir() -> Path:
     local = Path.cwd() / "worlds"
     if local.is_dir():
         return local
-    return Path(__file__).resolve().parent.parent / "worlds"
+    return Path(__file__).resolve().parents[2] / "worlds"
 
 
 def resolve_world(name_or_path: str | os.PathLike[str]) -> Path:

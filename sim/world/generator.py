@@ -232,7 +232,6 @@ def generate(seed: int, *, style: str = "office", size: str = "medium", signage:
         tags[tag_id] = Tag(tag_id, round(x, 4), round(y, 4), theta, "label", opening.place)
 
     facts = Facts(place_positions(hierarchy, tags, params.behind_m), hierarchy, params)
-    start_xy = np.array(layout.start[:2])
     world0 = _world(world_name(seed, style, size, signage), plan, tags, layout, goal_roles)
     oracle = oracle_paths(world0, sorted(goal_roles), params=params.oracle)
 

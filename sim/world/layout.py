@@ -236,7 +236,8 @@ def _block_rects(layout_lines: tuple[list[float], list[float]], wx: dict[int, fl
         i, j = b
         sides = block_sides(b)
 
-        def side(line: int, coords: list[float], widths: dict[int, float], e: Edge, sign: float) -> float:
+        def side(line: int, coords: list[float], widths: dict[int, float], e: Edge, sign: float,
+                 b: Node = b) -> float:
             if line == 0:
                 return HALF_WALL_M
             if line == len(coords) - 1:

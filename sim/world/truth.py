@@ -4,11 +4,11 @@ Shared by the generator (it writes only what these call true) and the world
 check (it reports what they call false). Positions come from what a world
 folder holds:
 
-- a place with no children (a room) lies ``behind_m`` behind the face of its
-  label (the mean over its labels, when it has several); a leaf with no label
-  has no position;
-- a place with children (an area, a wing, the building) lies at the mean of
-  its children's positions;
+- a place with a label lies ``behind_m`` behind the label's face (the mean
+  over its labels, when it has several): a label is the direct evidence of
+  where a place is (rooms; areas labelled at their entrance, as in the zoo);
+- a place with no label lies at the mean of its children's positions (areas,
+  wings, the building); one with neither has no position;
 - a sign's context ("here", or no ``from ...``) is the sign's tag position.
 
 Tests (``tolerance_deg`` 45 by default; F the figure, R a referent, C the context):
@@ -17,7 +17,7 @@ Tests (``tolerance_deg`` 45 by default; F the figure, R a referent, C the contex
 |---|---|
 | past, after, beyond | F lies on, beyond R, the line from C through R: angle between C->R and R->F <= tolerance |
 | before, towards, toward | R lies past F (as above with F and R swapped): angle between C->F and F->R <= tolerance |
-| left of / right of | the angle at R from R->C to R->F is -90 / +90 degrees within tolerance (the reader at C facing R has F on that hand) |
+| left of / right of | angle at R from R->C to R->F is -90 / +90 deg +- tolerance (F on that hand, from C facing R) |
 | beside, by, near, with, next to | F within ``near_m`` of R; a place "near here" must also lie behind the sign's face |
 | between | the angle at F between F->R0 and F->R1 >= 180 - tolerance |
 | in, inside, within | R is an ancestor of F in the hierarchy |
@@ -46,8 +46,8 @@ from shapely.geometry import LineString
 
 from abstract_map.hierarchy import Hierarchy
 from abstract_map.prepositions import ARROWS, PREPOSITIONS, TABLE
-from sim.world.oracle import OracleParams, distance_field, free_cells, nearest_cell, pool_plan, readable_cells
 from sim.world.data import Floorplan, Tag
+from sim.world.oracle import OracleParams, distance_field, free_cells, nearest_cell, pool_plan, readable_cells
 
 
 @dataclass(frozen=True)
@@ -113,11 +113,11 @@ def place_positions(hierarchy: Hierarchy, tags: Mapping[int, Tag], behind_m: flo
     def visit(name: str) -> np.ndarray | None:
         if name in positions:
             return positions[name]
-        if name in kids:
-            found = [p for p in (visit(c) for c in kids[name]) if p is not None]
-            pos = np.mean(found, axis=0) if found else None
+        if name in labels:
+            pos = np.mean(labels[name], axis=0)
         else:
-            pos = np.mean(labels[name], axis=0) if name in labels else None
+            found = [p for p in (visit(c) for c in kids.get(name, [])) if p is not None]
+            pos = np.mean(found, axis=0) if found else None
         if pos is not None:
             positions[name] = pos
         return pos
@@ -160,7 +160,8 @@ def _side(sign: float, word: str) -> Test:
         limit = slack * facts.params.tolerance_deg
         if err <= limit:
             return None
-        return f"from {ctx} facing {refs[0]}, {fig} is at {angle:+.0f} deg, not {word} ({sign * 90:+.0f} +- {limit:.0f})"
+        return (f"from {ctx} facing {refs[0]}, {fig} is at {angle:+.0f} deg, "
+                f"not {word} ({sign * 90:+.0f} +- {limit:.0f})")
     return test
 
 
@@ -181,7 +182,9 @@ def _between(facts: Facts, fig: str, refs: tuple[str, ...], ctx: str, slack: flo
     f, a, b = _pos(facts, fig, refs[0], refs[1])
     angle = angle_between(a - f, b - f)
     limit = 180.0 - slack * facts.params.tolerance_deg
-    return None if angle >= limit else f"{refs[0]} and {refs[1]} are {angle:.0f} deg apart seen from {fig} (< {limit:.0f})"
+    if angle >= limit:
+        return None
+    return f"{refs[0]} and {refs[1]} are {angle:.0f} deg apart seen from {fig} (< {limit:.0f})"
 
 
 def _in(facts: Facts, fig: str, refs: tuple[str, ...], ctx: str, slack: float) -> str | None:
