@@ -72,6 +72,7 @@ class Frame:
     places: dict[str, tuple[float, float]]
     target: tuple[float, float]
     path: np.ndarray | None
+    layers: dict[str, np.ndarray] = field(default_factory=dict)  # uint8 (0-255) images on the grid, e.g. belief
 
 
 @dataclass
@@ -258,7 +259,9 @@ class Trial:
     def snapshot(self, pose: tuple[float, float, float]) -> Frame:
         """An animation frame of the trial now."""
         places, target, path = self.policy.picture()
-        return Frame(self.t, pose, self.grid.to_image(), places, target, path)
+        layers = getattr(self.policy, "layers", dict)()
+        images = {name: np.round(255 * np.clip(image, 0.0, 1.0)).astype(np.uint8) for name, image in layers.items()}
+        return Frame(self.t, pose, self.grid.to_image(), places, target, path, images)
 
     def result(self) -> TrialResult:
         """What the trial did so far, as written to result.json."""

@@ -44,6 +44,8 @@ class BeliefParams:
     sigma_min_m: float = 2.0  # m, spread of the goal's prior with evidence right beside it
     sigma_per_m: float = 0.35  # m of spread per m between the imagined goal and the nearest observed anchor
     label_offset_m: float = 2.0  # m, a place's label hangs about this far from the place (level-1 label length)
+    tail_weight: float = 0.25  # share of the prior in a wide tail: the model may be wrong (a sign misread, a guess)
+    tail_scale: float = 3.0  # the tail's spread, in multiples of sigma
 
 
 @dataclass(frozen=True)
@@ -84,36 +86,62 @@ def wall_axes(occupied: np.ndarray, smoothing_cells: float) -> tuple[np.ndarray,
 
 
 def sight_clear(occupied: np.ndarray, grid: OccupancyGrid, origin_xy: np.ndarray, ends_xy: np.ndarray,
-                skip_m: float) -> np.ndarray:
+                skip_m: float, step_cells: float = 0.5) -> np.ndarray:
     """For each end (N, 2 m), whether the segment from ``origin_xy`` (one point, or one per end) to it, less
-    its last ``skip_m``, misses every cell set in ``occupied`` (sampled every half cell; off the grid blocks)."""
-    ends = np.atleast_2d(ends_xy)
+    its last ``skip_m``, misses every cell set in ``occupied`` (sampled every ``step_cells`` cells; cells off
+    the grid count as clear)."""
+    ends = np.atleast_2d(np.asarray(ends_xy, dtype=float))
     if len(ends) == 0:
         return np.zeros(0, dtype=bool)
     origins = np.broadcast_to(np.asarray(origin_xy, dtype=float), ends.shape)
-    delta = ends - origins
-    length = np.hypot(delta[:, 0], delta[:, 1])
-    step = 0.5 * grid.resolution
-    n = max(2, int(math.ceil(float(length.max()) / step)) + 1)
-    s = np.linspace(0.0, 1.0, n)[None, :]
-    reach = np.maximum(length - skip_m, 0.0) / np.maximum(length, 1e-9)
-    use = s <= reach[:, None]
-    pts = origins[:, None, :] + s[..., None] * delta[:, None, :]
-    rc = grid.world_to_cell(pts.reshape(-1, 2)).reshape(len(ends), n, 2)
+    res = grid.resolution
+    x0, y0 = grid.origin
     rows, cols = occupied.shape
-    inside = (rc[..., 0] >= 0) & (rc[..., 0] < rows) & (rc[..., 1] >= 0) & (rc[..., 1] < cols)
-    hit = np.ones(inside.shape, dtype=bool)
-    hit[inside] = occupied[rc[..., 0][inside], rc[..., 1][inside]]
-    return ~np.any(hit & use, axis=1)
+    # Continuous cell coordinates: col = floor(u), row = rows - 1 - floor(v).
+    u0, v0 = (origins[:, 0] - x0) / res, (origins[:, 1] - y0) / res
+    du, dv = (ends[:, 0] - x0) / res - u0, (ends[:, 1] - y0) / res - v0
+    length = np.hypot(du, dv)
+    n = max(2, int(math.ceil(float(length.max()) / step_cells)) + 1)
+    s = np.linspace(0.0, 1.0, n, dtype=np.float32)[None, :]
+    use = s <= (np.maximum(length - skip_m / res, 0.0) / np.maximum(length, 1e-9))[:, None]
+    col = np.clip(np.floor(u0[:, None] + s * du[:, None]).astype(np.intp), 0, cols - 1)
+    row = np.clip(rows - 1 - np.floor(v0[:, None] + s * dv[:, None]).astype(np.intp), 0, rows - 1)
+    return ~np.any(occupied[row, col] & use, axis=1)
+
+
+def face_normals(occupied: np.ndarray, smoothing_cells: float
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per cell: the face normal (nx, ny) along the wall's axis towards its open side, whether the cell is a
+    one-sided face (1.0: open on one side of the axis only, 0.0: both or neither), and from
+    :func:`wall_axes` the unsigned axis angle (rad) and its coherence."""
+    axis, coherence = wall_axes(occupied, smoothing_cells)
+    ux, uy = np.cos(axis), np.sin(axis)
+    rows, cols = occupied.shape
+    rr, cc = np.mgrid[0:rows, 0:cols]
+    dr, dc = -np.rint(uy).astype(np.intp), np.rint(ux).astype(np.intp)
+    ahead = ~occupied[np.clip(rr + dr, 0, rows - 1), np.clip(cc + dc, 0, cols - 1)]
+    behind = ~occupied[np.clip(rr - dr, 0, rows - 1), np.clip(cc - dc, 0, cols - 1)]
+    sign = np.where(ahead & ~behind, 1.0, np.where(behind & ~ahead, -1.0, 0.0))
+    return sign * ux, sign * uy, np.abs(sign), axis, coherence
 
 
 def in_cone(site_xy: np.ndarray, camera_xy: np.ndarray, axis: np.ndarray, coherence: np.ndarray,
-            params: BeliefParams) -> np.ndarray:
-    """Whether each camera-site pair lies inside the reading cone about the site's wall normal (either side)."""
+            params: BeliefParams, normal: np.ndarray | None = None, sided: np.ndarray | None = None) -> np.ndarray:
+    """Whether each camera-site pair lies inside the reading cone about the site's wall normal.
+
+    Where the wall has one mapped face (``sided`` >= 0.5) the camera must be in
+    front of it (``normal``, (..., 2), points to the free side); otherwise
+    either side of the unsigned ``axis`` counts; at corners (low coherence) any.
+    """
     d = np.asarray(camera_xy, dtype=float) - np.asarray(site_xy, dtype=float)
     distance = np.maximum(np.hypot(d[..., 0], d[..., 1]), 1e-9)
-    cos_off = np.abs(d[..., 0] * np.cos(axis) + d[..., 1] * np.sin(axis)) / distance
-    return (cos_off >= math.cos(math.radians(params.cone_half_angle_deg))) | (coherence < params.corner_coherence)
+    cos_min = math.cos(math.radians(params.cone_half_angle_deg))
+    unsigned = np.abs(d[..., 0] * np.cos(axis) + d[..., 1] * np.sin(axis)) / distance
+    ok = (unsigned >= cos_min) | (coherence < params.corner_coherence)
+    if normal is not None and sided is not None:
+        signed = (d[..., 0] * normal[..., 0] + d[..., 1] * normal[..., 1]) / distance
+        ok = np.where(sided >= 0.5, signed >= cos_min, ok)
+    return ok
 
 
 class SweptSpace:
@@ -146,9 +174,10 @@ class SweptSpace:
         # Wall orientation from a margin around the window, so walls at its edge are judged whole.
         m = int(math.ceil(3 * prm.normal_smoothing_m / res)) + 1
         q0, q1, p0, p1 = max(0, r0 - m), min(rows, r1 + m), max(0, c0 - m), min(cols, c1 + m)
-        axis, coherence = wall_axes(occupied[q0:q1, p0:p1], prm.normal_smoothing_m / res)
-        local = cand - np.array([q0, p0])
-        ok = in_cone(xy, camera, axis[local[:, 0], local[:, 1]], coherence[local[:, 0], local[:, 1]], prm)
+        nx, ny, sided, axis, coherence = face_normals(occupied[q0:q1, p0:p1], prm.normal_smoothing_m / res)
+        i, j = (cand - np.array([q0, p0])).T
+        ok = in_cone(xy, camera, axis[i, j], coherence[i, j], prm, np.stack([nx[i, j], ny[i, j]], axis=-1),
+                     sided[i, j])
         cand, xy = cand[ok], xy[ok]
         clear = sight_clear(occupied, grid, camera, xy, prm.los_skip_m)
         cells = cand[clear]
@@ -177,7 +206,10 @@ def goal_sigma(goal_xy: np.ndarray, anchors_xy: np.ndarray, params: BeliefParams
 
 def goal_belief(grid: OccupancyGrid, swept: np.ndarray, goal_xy: np.ndarray, sigma_m: float,
                 params: BeliefParams) -> Belief:
-    """Posterior over the label's cell: Gaussian prior x wall chance x (1 - detect_prob on swept cells).
+    """Posterior over the label's cell: prior x wall chance x (1 - detect_prob on swept cells).
+
+    The prior is a Gaussian of spread ``sigma_m`` about ``goal_xy`` mixed with a
+    wide tail (``tail_weight``, ``tail_scale`` times the spread).
 
     ``remaining`` is the posterior's normaliser against the prior's, both with
     every cell weighted by the wall chance of an unseen cell: near 1 when
@@ -187,9 +219,11 @@ def goal_belief(grid: OccupancyGrid, swept: np.ndarray, goal_xy: np.ndarray, sig
     rows, cols = grid.shape
     xy_col = grid.cell_to_world(np.stack([np.zeros(cols), np.arange(cols)], axis=1))[:, 0]
     xy_row = grid.cell_to_world(np.stack([np.arange(rows), np.zeros(rows)], axis=1))[:, 1]
-    gx = np.exp(-0.5 * ((xy_col - centre[0]) / sigma_m) ** 2)
-    gy = np.exp(-0.5 * ((xy_row - centre[1]) / sigma_m) ** 2)
-    prior = np.outer(gy, gx)
+    prior = np.zeros((rows, cols))
+    for weight, spread in ((1.0 - params.tail_weight, sigma_m), (params.tail_weight, params.tail_scale * sigma_m)):
+        gx = np.exp(-0.5 * ((xy_col - centre[0]) / spread) ** 2)
+        gy = np.exp(-0.5 * ((xy_row - centre[1]) / spread) ** 2)
+        prior += weight / spread ** 2 * np.outer(gy, gx)
     wall = np.where(grid.occupied_mask(), 1.0, np.where(grid.free_mask(), 0.0, params.unknown_wall_prob))
     posterior = prior * wall * np.where(swept, 1.0 - params.detect_prob, 1.0)
     reference = params.unknown_wall_prob * float(prior.sum())  # the prior's mass as if no cell were seen

@@ -219,7 +219,7 @@ class ViewpointPolicy:
             self.bumps += 1
             self.belief = self._goal_belief(grid, robot_xy)
         mass = self.belief.mass + vp.cue_weight * cue_mass(grid, self.swept.swept, robot_xy, vp.cue_radius_m, bp)
-        travel = travel_costs(grid, robot_xy, self.params.planner, vp.escape_cost)
+        travel = travel_costs(grid, robot_xy, self.params.planner, vp.escape_cost, pool=vp.travel_pool)
         self.views = views = score_viewpoints(grid, travel, mass, vp, bp, self.visited)
         self.target_at = t_s
         best = views.best()

@@ -21,7 +21,7 @@ from scipy.spatial import cKDTree
 from skimage.graph import MCP_Geometric
 
 from sim.mapping.occupancy import OccupancyGrid
-from sim.navigation.belief import BeliefParams, cell_window, in_cone, sight_clear, wall_axes
+from sim.navigation.belief import BeliefParams, cell_window, face_normals, in_cone, sight_clear
 from sim.navigation.planner import PlannerParams, cost_map
 
 
@@ -30,9 +30,11 @@ class ViewpointParams:
     """How viewpoints are valued and chosen."""
 
     block_m: float = 0.5  # m, belief pooled into sites, and viewpoints spaced, at this block size
-    max_sites: int = 400  # sites (blocks) of most mass considered; the rest is a thin tail
+    max_sites: int = 150  # sites (blocks) of most mass considered; the rest is a thin tail
+    min_site_share: float = 0.01  # sites with less than this share of the heaviest site's mass are dropped
+    travel_pool: int = 2  # travel costs are searched on cells this many times coarser (cheapest cell of each)
     unknown_view_prob: float = 0.5  # chance an unseen label faces a viewpoint that has a clear line to it
-    site_skip_m: float = 0.15  # m; sight lines stop this short of a site (its own wall)
+    site_skip_m: float = 0.09  # m; sight lines stop this short of a site's cell centre (inside its own cell)
     cue_weight: float = 0.25  # value of all unswept wall near the robot (cue seeking) against the goal belief's 1
     cue_radius_m: float = 10.0  # m from the robot within which unswept wall counts for cue seeking
     travel_offset_m: float = 4.0  # m added to travel in the score value / (travel + offset): favours near reads
@@ -60,8 +62,11 @@ class Viewpoints:
 
 
 def travel_costs(grid: OccupancyGrid, robot_xy: np.ndarray, planner: PlannerParams, escape_cost: float,
-                 costs: np.ndarray | None = None) -> np.ndarray:
-    """Planning cost (m, the planner's cost model; unseen space as cheap as free) from the robot to every cell."""
+                 costs: np.ndarray | None = None, pool: int = 1) -> np.ndarray:
+    """Planning cost (m, the planner's cost model; unseen space as cheap as free) from the robot to every cell.
+
+    With ``pool`` > 1 the search runs on blocks of pool x pool cells, each as cheap
+    as its cheapest cell (an estimate for valuing targets, not a path)."""
     if costs is None:
         costs = cost_map(grid, planner).costs
     costs = costs.copy()
@@ -74,44 +79,58 @@ def travel_costs(grid: OccupancyGrid, robot_xy: np.ndarray, planner: PlannerPara
     window = costs[r0:r1, c0:c1]
     window[np.isinf(window) & ~occupied] = escape_cost
     costs[rc[0], rc[1]] = min(costs[rc[0], rc[1]], escape_cost)
-    cumulative, _ = MCP_Geometric(costs, fully_connected=True).find_costs([tuple(rc)])
-    return cumulative * grid.resolution
+    if pool <= 1:
+        cumulative, _ = MCP_Geometric(costs, fully_connected=True).find_costs([tuple(rc)])
+        return cumulative * grid.resolution
+    pr, pc = -(-rows // pool) * pool, -(-cols // pool) * pool
+    padded = np.full((pr, pc), np.inf)
+    padded[:rows, :cols] = costs
+    coarse = padded.reshape(pr // pool, pool, pc // pool, pool).min(axis=(1, 3))
+    cumulative, _ = MCP_Geometric(coarse, fully_connected=True).find_costs([tuple(rc // pool)])
+    fine = np.repeat(np.repeat(cumulative, pool, axis=0), pool, axis=1)[:rows, :cols]
+    return fine * grid.resolution * pool
 
 
-def pool_sites(grid: OccupancyGrid, mass: np.ndarray, block_cells: int, max_sites: int
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Belief pooled into blocks: (xy (K, 2) m mass-weighted centre, mass (K,), wall share (K,),
-    wall-normal angle (K,) rad, coherence (K,)) of the ``max_sites`` blocks of most mass."""
+@dataclass(frozen=True)
+class Sites:
+    """Belief pooled into blocks (K of them)."""
+
+    xy: np.ndarray  # (K, 2) m, mass-weighted centre
+    mass: np.ndarray  # (K,)
+    wall: np.ndarray  # (K,) share of the mass on mapped wall
+    axis: np.ndarray  # (K,) rad, unsigned wall-normal angle
+    coherence: np.ndarray  # (K,) of that axis
+    normal: np.ndarray  # (K, 2) mean face normal (to the free side)
+    sided: np.ndarray  # (K,) how one-sided the wall is (>= 0.5: only its front reads)
+
+
+def pool_sites(grid: OccupancyGrid, mass: np.ndarray, block_cells: int, max_sites: int, smoothing_cells: float,
+               min_share: float = 0.0) -> Sites:
+    """The ``max_sites`` blocks of most mass (and at least ``min_share`` of the heaviest's)."""
     rows, cols = mass.shape
     b = block_cells
     pr, pc = -(-rows // b) * b, -(-cols // b) * b
     occupied = grid.occupied_mask()
-    angle, coherence = wall_axes(occupied, 2.0)
-
-    def pool(a: np.ndarray) -> np.ndarray:
-        padded = np.zeros((pr, pc), dtype=np.float64)
-        padded[:rows, :cols] = a
-        return padded.reshape(pr // b, b, pc // b, b).sum(axis=(1, 3))
-
-    rr, cc = np.mgrid[0:rows, 0:cols]
-    m = pool(mass)
+    nx, ny, sided, angle, coherence = face_normals(occupied, smoothing_cells)
+    padded = np.zeros((pr, pc), dtype=np.float64)
+    padded[:rows, :cols] = mass
+    blocks = padded.reshape(pr // b, b, pc // b, b).transpose(0, 2, 1, 3).reshape(pr // b, pc // b, b * b)
+    m = blocks.sum(axis=2)
     keep = np.argwhere(m > 0)
     if len(keep) == 0:
         empty = np.zeros(0)
-        return np.zeros((0, 2)), empty, empty, empty, empty
-    order = np.argsort(-m[keep[:, 0], keep[:, 1]])[:max_sites]
-    keep = keep[order]
-    mr, mc = pool(mass * rr)[keep[:, 0], keep[:, 1]], pool(mass * cc)[keep[:, 0], keep[:, 1]]
-    total = m[keep[:, 0], keep[:, 1]]
-    xy = grid.cell_to_world(np.stack([mr / total, mc / total], axis=1))
-    wall_mass = mass * occupied
-    wall = pool(wall_mass)[keep[:, 0], keep[:, 1]]
-    weight = wall_mass * coherence
-    c2 = pool(weight * np.cos(2 * angle))[keep[:, 0], keep[:, 1]]
-    s2 = pool(weight * np.sin(2 * angle))[keep[:, 0], keep[:, 1]]
-    axis = 0.5 * np.arctan2(s2, c2)
-    coh = np.hypot(c2, s2) / np.maximum(wall, 1e-12)
-    return xy, total, wall / total, axis, coh
+        return Sites(np.zeros((0, 2)), empty, empty, empty, empty, np.zeros((0, 2)), empty)
+    kept = m[keep[:, 0], keep[:, 1]]
+    order = np.argsort(-kept)[:max_sites]
+    keep = keep[order][kept[order] >= min_share * kept.max()]
+    # Each site stands at its block's heaviest cell, with that cell's wall geometry.
+    k = np.argmax(blocks[keep[:, 0], keep[:, 1]], axis=1)
+    r = np.minimum(keep[:, 0] * b + k // b, rows - 1)
+    c = np.minimum(keep[:, 1] * b + k % b, cols - 1)
+    xy = grid.cell_to_world(np.stack([r, c], axis=1))
+    wall = occupied[r, c].astype(float)
+    return Sites(xy, m[keep[:, 0], keep[:, 1]], wall, angle[r, c], coherence[r, c],
+                 np.stack([nx[r, c], ny[r, c]], axis=1), sided[r, c])
 
 
 def score_viewpoints(grid: OccupancyGrid, travel_m: np.ndarray, site_mass: np.ndarray, params: ViewpointParams,
@@ -119,7 +138,8 @@ def score_viewpoints(grid: OccupancyGrid, travel_m: np.ndarray, site_mass: np.nd
     """Every reachable block centre, valued by the site mass (per grid cell, any scale) readable from it."""
     res = grid.resolution
     b = max(1, round(params.block_m / res))
-    xy_s, mass_s, wall_s, axis_s, coh_s = pool_sites(grid, site_mass, b, params.max_sites)
+    sites = pool_sites(grid, site_mass, b, params.max_sites, belief.normal_smoothing_m / res, params.min_site_share)
+    xy_s, mass_s, wall_s = sites.xy, sites.mass, sites.wall
     rows, cols = grid.shape
     centres = np.argwhere(np.ones((-(-rows // b), -(-cols // b)), dtype=bool)) * b + b // 2
     centres = centres[(centres[:, 0] < rows) & (centres[:, 1] < cols)]
@@ -135,7 +155,8 @@ def score_viewpoints(grid: OccupancyGrid, travel_m: np.ndarray, site_mass: np.nd
             d = np.hypot(*(xy_v[view] - xy_s[site]).T)
             ok = d >= belief.read_min_m
             site, view = site[ok], view[ok]
-            cone = in_cone(xy_s[site], xy_v[view], axis_s[site], coh_s[site], belief)
+            cone = in_cone(xy_s[site], xy_v[view], sites.axis[site], sites.coherence[site], belief,
+                           sites.normal[site], sites.sided[site])
             factor = wall_s[site] * cone + (1.0 - wall_s[site]) * params.unknown_view_prob
             live = factor > 0
             site, view, factor = site[live], view[live], factor[live]
@@ -153,5 +174,5 @@ def _clear_pairs(grid: OccupancyGrid, origins: np.ndarray, ends: np.ndarray, ski
     occupied = grid.occupied_mask()
     out = np.zeros(len(origins), dtype=bool)
     for k in range(0, len(origins), chunk):
-        out[k:k + chunk] = sight_clear(occupied, grid, origins[k:k + chunk], ends[k:k + chunk], skip_m)
+        out[k:k + chunk] = sight_clear(occupied, grid, origins[k:k + chunk], ends[k:k + chunk], skip_m, 1.0)
     return out
