@@ -3,13 +3,15 @@
 Example:
   abstract-map trial --world zoo --goal Lion --out runs/lion
   abstract-map trial --world zoo --goal Toilets --perception geometric --seed 3 --out runs/t3 --record
+  abstract-map trial --world zoo --goal Lion --navigator viewpoint --out runs/lion-viewpoint --record
 
 Prints a live progress line (simulated time, distance, cues read), then writes
 DIR/result.json (goal, success, reason, distance_m, simulated and wall seconds,
 cues read in order with the distance at each, the trajectory) and
 DIR/trajectory.png (floor plan, path, tags read, final imagined places).
 --record also writes DIR/run.gif, an animation of the robot, the explored map
-and the abstract map. Exit code 0 when the goal was found, 1 when the trial
+and the abstract map (with --navigator viewpoint also the goal belief, magenta,
+and the swept space, blue). Exit code 0 when the goal was found, 1 when the trial
 failed (the reason is in result.json), 2 on bad input.
 """
 
@@ -32,6 +34,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     parser.add_argument("--perception", default="camera", choices=["camera", "geometric"],
                         help="rendered camera + OpenCV AprilTag detector, or the fast geometric check")
+    parser.add_argument("--navigator", default="paper",
+                        help="navigation policy: paper (the paper's robot, default) or viewpoint (negative "
+                             "information: to where the goal's label may still be read)")
     parser.add_argument("--out", type=Path, required=True, help="output folder")
     parser.add_argument("--record", action="store_true", help="also write DIR/run.gif, an animation of the run")
     parser.add_argument("--max-sim-s", type=float, default=None, help="cap on simulated seconds (default 900)")
@@ -42,7 +47,11 @@ def run(args: argparse.Namespace) -> int:
 
     from sim.experiments.pictures import animation, trajectory_picture
     from sim.experiments.trial import TrialParams, run_trial
+    from sim.navigation.policies import NAVIGATORS
     from sim.world.data import WorldError, load_world
+
+    if args.navigator not in NAVIGATORS:
+        raise ExitError(f"--navigator {args.navigator!r}: expected one of {', '.join(sorted(NAVIGATORS))}")
 
     try:
         world = load_world(args.world)
@@ -61,8 +70,8 @@ def run(args: argparse.Namespace) -> int:
             print(line, file=sys.stderr, flush=True)
 
     try:
-        result = run_trial(world, args.goal, seed=args.seed, perception=args.perception, params=params,
-                           progress=progress, record=args.record)
+        result = run_trial(world, args.goal, seed=args.seed, perception=args.perception, navigator=args.navigator,
+                           params=params, progress=progress, record=args.record)
     except ValueError as exc:
         raise ExitError(str(exc)) from exc
     if live:

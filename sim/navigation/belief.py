@@ -40,11 +40,11 @@ class BeliefParams:
     detect_prob: float = 0.95  # chance a label in swept space would have been read (camera misses, odd walls)
     normal_smoothing_m: float = 0.2  # m, std of the smoothing of the wall-orientation (structure) tensor
     corner_coherence: float = 0.3  # below this wall-orientation coherence (corners, specks) any view angle counts
-    unknown_wall_prob: float = 0.15  # chance an unseen cell is wall: ~ wall cells / floor cells of built floors
+    unknown_wall_prob: float = 0.05  # chance an unseen cell holds a label-bearing wall face, against a mapped face's 1
     sigma_min_m: float = 2.0  # m, spread of the goal's prior with evidence right beside it
     sigma_per_m: float = 0.35  # m of spread per m between the imagined goal and the nearest observed anchor
     label_offset_m: float = 2.0  # m, a place's label hangs about this far from the place (level-1 label length)
-    tail_weight: float = 0.25  # share of the prior in a wide tail: the model may be wrong (a sign misread, a guess)
+    tail_weight: float = 0.15  # share of the prior in a wide tail: the model may be wrong (a sign misread, a guess)
     tail_scale: float = 3.0  # the tail's spread, in multiples of sigma
 
 
@@ -211,9 +211,9 @@ def goal_belief(grid: OccupancyGrid, swept: np.ndarray, goal_xy: np.ndarray, sig
     The prior is a Gaussian of spread ``sigma_m`` about ``goal_xy`` mixed with a
     wide tail (``tail_weight``, ``tail_scale`` times the spread).
 
-    ``remaining`` is the posterior's normaliser against the prior's, both with
-    every cell weighted by the wall chance of an unseen cell: near 1 when
-    nothing near the goal has been looked at, near 0 when it all has.
+    ``remaining`` is the posterior's normaliser against the prior's (both with
+    each cell's wall chance): the share of the prior on wall not yet swept, near
+    1 when nothing near the goal has been looked at, near 0 when it all has.
     """
     centre = np.asarray(goal_xy, dtype=float)
     rows, cols = grid.shape
@@ -225,8 +225,9 @@ def goal_belief(grid: OccupancyGrid, swept: np.ndarray, goal_xy: np.ndarray, sig
         gy = np.exp(-0.5 * ((xy_row - centre[1]) / spread) ** 2)
         prior += weight / spread ** 2 * np.outer(gy, gx)
     wall = np.where(grid.occupied_mask(), 1.0, np.where(grid.free_mask(), 0.0, params.unknown_wall_prob))
-    posterior = prior * wall * np.where(swept, 1.0 - params.detect_prob, 1.0)
-    reference = params.unknown_wall_prob * float(prior.sum())  # the prior's mass as if no cell were seen
+    weighted = prior * wall
+    posterior = weighted * np.where(swept, 1.0 - params.detect_prob, 1.0)
+    reference = float(weighted.sum())
     total = float(posterior.sum())
     mass = posterior / total if total > 0 else posterior
     remaining = min(1.0, total / reference) if reference > 0 else 0.0

@@ -204,9 +204,9 @@ class ViewpointPolicy:
 
     def _goal_belief(self, grid: OccupancyGrid, robot_xy: np.ndarray) -> Belief:
         assert self.swept is not None
-        goal = self.nav.target(robot_xy)
+        goal = self.nav.model.goal_estimate()  # off the map too: the prior's near edge then lies on it
         anchors = np.array([f.xy for f in self.nav.model.fixed.values()])
-        sigma = goal_sigma(self.nav.model.goal_estimate(), anchors, self.params.belief)
+        sigma = goal_sigma(goal, anchors, self.params.belief)
         return goal_belief(grid, self.swept.swept, goal, sigma, self.params.belief)
 
     def _retarget(self, t_s: float, robot_xy: np.ndarray, grid: OccupancyGrid) -> None:
@@ -214,8 +214,9 @@ class ViewpointPolicy:
         vp, bp = self.params.viewpoints, self.params.belief
         assert self.swept is not None
         self.belief = self._goal_belief(grid, robot_xy)
-        # Negative information fed back into the abstract map: the label is not where the model imagines it.
-        while self.belief.remaining < vp.exhausted_remaining and self.nav.arrived_without_goal(grid.explored_centre()):
+        # Negative information fed back into the abstract map: the label is not where the model imagines it
+        # (one growth step per re-valuing, so the model moves out gradually).
+        if self.belief.remaining < vp.exhausted_remaining and self.nav.arrived_without_goal(grid.explored_centre()):
             self.bumps += 1
             self.belief = self._goal_belief(grid, robot_xy)
         mass = self.belief.mass + vp.cue_weight * cue_mass(grid, self.swept.swept, robot_xy, vp.cue_radius_m, bp)

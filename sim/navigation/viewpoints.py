@@ -35,9 +35,9 @@ class ViewpointParams:
     travel_pool: int = 2  # travel costs are searched on cells this many times coarser (cheapest cell of each)
     unknown_view_prob: float = 0.5  # chance an unseen label faces a viewpoint that has a clear line to it
     site_skip_m: float = 0.09  # m; sight lines stop this short of a site's cell centre (inside its own cell)
-    cue_weight: float = 0.25  # value of all unswept wall near the robot (cue seeking) against the goal belief's 1
+    cue_weight: float = 0.1  # value of all unswept wall near the robot (cue seeking) against the goal belief's 1
     cue_radius_m: float = 10.0  # m from the robot within which unswept wall counts for cue seeking
-    travel_offset_m: float = 4.0  # m added to travel in the score value / (travel + offset): favours near reads
+    travel_offset_m: float = 6.0  # m added to travel in the score value / (travel + offset): favours near reads
     keep_ratio: float = 0.75  # keep the current target while its score is at least this share of the best
     visited_radius_m: float = 1.0  # m; a viewpoint reached once is not a target again within this
     escape_cost: float = 20.0  # cost per cell of the impassable band right around the robot (it may be brushing)

@@ -26,7 +26,7 @@ def test_viewpoint_finds_a_goal_in_a_small_generated_building(tmp_path):
     from sim.world.oracle import oracle_path
 
     world = load_world(generated_world(3, style="office", size="small", signage="complete", root=tmp_path))
-    goal = sorted(world.goals)[0]
+    goal = "Finance Kitchen"  # 10.3 m for the oracle: a short smoke run
     result = run_trial(world, goal, perception="geometric", navigator="viewpoint")
     assert result.success, result.reason
     assert result.distance_m < 3.0 * oracle_path(world, goal).length_m + 5.0
@@ -42,3 +42,12 @@ def test_viewpoint_finds_every_goal_of_a_generated_building(tmp_path, style):
     for goal in sorted(world.goals):
         result = run_trial(world, goal, perception="geometric", navigator="viewpoint")
         assert result.success, (goal, result.reason)
+
+
+def test_trial_command_rejects_an_unknown_navigator(tiny_world, tmp_path, capsys):
+    from abstract_map.cli import main
+
+    code = main(["trial", "--world", str(tiny_world.root), "--goal", "A", "--navigator", "teleport",
+                 "--out", str(tmp_path)])
+    assert code == 2
+    assert "teleport" in capsys.readouterr().err
