@@ -29,7 +29,7 @@ def test_viewpoint_finds_a_goal_in_a_small_generated_building(tmp_path):
     goal = "Finance Kitchen"  # 10.3 m for the oracle: a short smoke run
     result = run_trial(world, goal, perception="geometric", navigator="viewpoint")
     assert result.success, result.reason
-    assert result.distance_m < 3.0 * oracle_path(world, goal).length_m + 5.0
+    assert result.distance_m < 5.0 * oracle_path(world, goal).length_m + 10.0  # no wandering: a loose bound
 
 
 @pytest.mark.slow
