@@ -2,14 +2,21 @@
 
 Run from the repository root:
 
-    python benchmarks/run.py                  # everything (about 10 minutes on 2 cores)
-    python benchmarks/run.py settle scaling   # just some of: settle, scaling, trials, study
+    python benchmarks/run.py                  # settle, scaling, trials, study, generate (10-15 minutes on 2 cores)
+    python benchmarks/run.py settle scaling   # just some of: settle, scaling, trials, study, generate, generalise
+    python benchmarks/run.py generalise       # the generalisation benchmark (within an hour on 2 cores)
+    python benchmarks/run.py generalise --buildings 6 --camera-buildings 2   # a quick run
 
 settle   median settle time per cue on the Lion replay (the authors' code: 1.5-5.6 s)
 scaling  settle time as the model grows: synthetic hierarchies of about 50, 500, 5,000 places with cues
          (a few minutes: the 5,000-place model takes about 13 ms per integration step)
 trials   wall time and real-time factor of the Lion trial, per perception mode
 study    total wall time of a small study (1 trial per goal, geometric, 2 workers)
+generate time to generate a building per style and size, and how many pass the world check
+generalise  test buildings (seeds 1000-1049, styles and signage levels cycling), 5 goals each, geometric
+         perception, navigators paper and frontier; then 10 of them (1000-1009) with the camera and the paper
+         navigator. Success, SPL, ratio to oracle and wall time per navigator and signage level, and per style.
+         A resumable study folder (--out, default runs/generalise); named only, never part of the default set.
 """
 
 from __future__ import annotations
@@ -22,6 +29,7 @@ import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -131,19 +139,135 @@ def bench_study(trials: int = 1, workers: int = 2, perception: str = "geometric"
           [[str(trials), perception, str(workers), f"{wall:.0f}"]])
 
 
+TEST_SEED = 1000  # the first test building: seeds 1000-1999 are for reporting only, never tuning
+
+
+def generalise_tables(records: list[dict], title: str) -> None:
+    """Success, SPL, ratio to oracle and wall time per navigator and signage level, then per style."""
+    from sim.experiments.summary import stats
+
+    header = ["perception", "navigator", "{}", "trials", "success", "SPL", "ratio to oracle", "wall per trial (s)",
+              "CPU per trial (s)", "wall in all (min)"]
+    for column in ("signage", "style"):
+        groups: dict[tuple[str, str, str], list[dict]] = {}
+        for record in records:
+            for value in (record.get(column) or "-", "all"):
+                key = (record["perception"], record["navigator"], value)
+                groups.setdefault(key, []).append(record)
+        rows = []
+        for (perception, navigator, value), mine in sorted(groups.items(), key=lambda kv: (kv[0][0], kv[0][1],
+                                                                                          kv[0][2] == "all", kv[0][2])):
+            s = stats(mine)
+            rows.append([perception, navigator, value, str(s["trials"]), f"{100 * s['success']:.0f}%",
+                         f"{s['spl']:.2f}", "-" if math.isnan(s["ratio"]) else f"{s['ratio']:.2f}",
+                         f"{s['wall']:.1f}", "-" if math.isnan(s["cpu"]) else f"{s['cpu']:.1f}",
+                         f"{sum(r.get('wall_s') or 0 for r in mine) / 60:.1f}"])
+        table(f"{title}, per navigator and {column}", [h.format(column) for h in header], rows)
+
+
+def finished_trials(out: Path) -> list[dict]:
+    """Every trial record already written under ``out`` (both parts), for a report of what has run so far."""
+    import json
+
+    records = []
+    for path in sorted(out.glob("*/trials/*/*.json")):
+        try:
+            records.append(json.loads(path.read_text()))
+        except (OSError, ValueError):
+            continue  # a file being written: counted next time
+    return records
+
+
+def bench_generalise(buildings: int = 50, camera_buildings: int = 10, workers: int = 2,
+                     out: Path = ROOT / "runs" / "generalise", report_only: bool = False) -> None:
+    from tqdm import tqdm
+
+    from sim.experiments.study import StudySettings
+    from sim.experiments.study_run import conduct_study
+
+    if report_only:
+        records = finished_trials(out)
+        generalise_tables(records, f"Generalisation, the {len(records)} trials finished so far in {out}")
+        return
+    began = time.perf_counter()
+    parts = [("geometric", buildings, ("paper", "frontier")), ("camera", camera_buildings, ("paper",))]
+    records: list[dict] = []
+    for perception, count, navigators in parts:
+        if count < 1:
+            continue
+        settings = StudySettings(worlds=(f"generated:{TEST_SEED}-{TEST_SEED + count - 1}",), perception=perception,
+                                 navigators=navigators, trials=1)
+        bar = tqdm(total=0, unit="trial", desc=perception, file=sys.stderr, dynamic_ncols=True)
+
+        def progress(done: int, total: int, record: dict | None, bar: Any = bar) -> None:
+            bar.total, bar.n = total, done
+            bar.refresh()
+
+        outcome = conduct_study(settings, out / perception, workers=workers, progress=progress)
+        bar.close()
+        records += outcome.records
+        print(f"generalise: {perception} done, {len(outcome.records)} trials, {outcome.wall_s / 60:.1f} min",
+              file=sys.stderr, flush=True)
+    wall = time.perf_counter() - began
+    generalise_tables(records, f"Generalisation over test buildings {TEST_SEED}-{TEST_SEED + buildings - 1} "
+                               f"(camera: first {camera_buildings}), 1 trial per goal, {workers} workers")
+    print(f"benchmark wall time: {wall / 60:.1f} min (trials resumed from {out} not counted)")
+
+
+def bench_generate(seeds: range = range(1000, 1005)) -> None:
+    """Generation time per style and size (median over seeds; CPU time, which load does not inflate, and wall)."""
+    from sim.world.check import check_world
+    from sim.world.generator import generate
+    from sim.world.styles import SIZES, STYLES
+
+    rows = []
+    for size in SIZES:
+        for style in STYLES:
+            cpu, wall, rooms, tags, passed = [], [], [], [], 0
+            for seed in seeds:
+                c0, w0 = time.process_time(), time.perf_counter()
+                g = generate(seed, style=style, size=size)
+                cpu.append(time.process_time() - c0)
+                wall.append(time.perf_counter() - w0)
+                rooms.append(len(g.layout.rooms))
+                tags.append(len(g.world.tags))
+                passed += check_world(g.world, hierarchy=g.hierarchy).ok
+            rows.append([size, style, f"{np.median(cpu):.2f}", f"{max(cpu):.2f}", f"{np.median(wall):.2f}",
+                         f"{min(rooms)}-{max(rooms)}", f"{min(tags)}-{max(tags)}", f"{passed}/{len(seeds)}"])
+    table("Generate", ["size", "style", "median CPU (s)", "max CPU (s)", "median wall (s)", "rooms", "tags",
+                       "pass world check"], rows)
+
+
 BENCHMARKS: dict[str, Callable[[], None]] = {"settle": bench_settle, "scaling": bench_scaling,
-                                             "trials": bench_trials, "study": bench_study}
+                                             "trials": bench_trials, "study": bench_study,
+                                             "generate": bench_generate}
+NAMED_ONLY = ("generalise",)  # too long for the default set; run by name
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("which", nargs="*", help=f"benchmarks to run, of {sorted(BENCHMARKS)} (default: all)")
+    parser.add_argument("which", nargs="*",
+                        help=f"benchmarks to run, of {sorted([*BENCHMARKS, *NAMED_ONLY])} "
+                             f"(default: {sorted(BENCHMARKS)})")
+    parser.add_argument("--buildings", type=int, default=50, help="generalise: test buildings, geometric (default 50)")
+    parser.add_argument("--camera-buildings", type=int, default=10,
+                        help="generalise: of those, how many with the camera (default 10)")
+    parser.add_argument("--workers", type=int, default=2, help="generalise: parallel trials (default 2)")
+    parser.add_argument("--out", type=Path, default=ROOT / "runs" / "generalise",
+                        help="generalise: study folder, re-used to resume (default runs/generalise)")
+    parser.add_argument("--report-only", action="store_true",
+                        help="generalise: tabulate the trials finished so far in --out; run nothing")
     args = parser.parse_args()
-    unknown = [w for w in args.which if w not in BENCHMARKS]
+    unknown = [w for w in args.which if w not in BENCHMARKS and w not in NAMED_ONLY]
     if unknown:
-        parser.error(f"unknown benchmark(s) {unknown}; choose from {sorted(BENCHMARKS)}")
+        parser.error(f"unknown benchmark(s) {unknown}; choose from {sorted([*BENCHMARKS, *NAMED_ONLY])}")
+    if not (1 <= args.buildings <= 1000 and 0 <= args.camera_buildings <= args.buildings and args.workers >= 1):
+        parser.error("--buildings must be 1-1000, --camera-buildings 0 to --buildings, --workers at least 1")
     for name in args.which or BENCHMARKS:
-        BENCHMARKS[name]()
+        if name == "generalise":
+            bench_generalise(args.buildings, args.camera_buildings, args.workers, args.out, args.report_only)
+        else:
+            BENCHMARKS[name]()
     return 0
 
 

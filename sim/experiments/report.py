@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from sim.experiments.pictures import draw_floorplan, draw_path, draw_tags
+from sim.experiments.study import slug
 from sim.world.data import World
 from sim.world.oracle import OraclePath
 
@@ -174,7 +175,7 @@ def path_pictures(world: World, records: list[dict[str, Any]], oracles: dict[str
         ax.set_title(f"{world.title}: paths to the {goal}")
         ax.legend(loc="lower right", fontsize=7)
         fig.tight_layout()
-        path = folder / f"{goal.replace(' ', '_')}.png"
+        path = folder / f"{slug(goal)}.png"  # a safe name: a goal's text never leaves the folder
         fig.savefig(path, dpi=100)
         plt.close(fig)
         written.append(path)

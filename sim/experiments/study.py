@@ -1,45 +1,79 @@
-"""A study: every goal of a world, N trials each, on a local process pool or a Ray cluster.
+"""A study: every goal of one or more worlds, N trials each per navigator, on a process pool or Ray.
 
 Trials differ by seed. A seed draws the start pose's jitter (std 0.10 m and 3
 degrees) and the recovery manoeuvre's turning direction; in geometric mode it
 also draws detection noise (std 0.03 m and 1 degree per sighting), while the
 camera mode's noise is the detector's own. Odometry is perfect, as in the
-paper's study. Each finished trial is written to ``DIR/trials/GOAL-SEED.json``
-at once, so an interrupted study run again skips what is done; a trial that
+paper's study. A trial is keyed by (world, navigator, goal, seed) and written
+to ``DIR/trials/WORLD/NAVIGATOR-GOAL-SEED-HASH.json`` (names made safe, the
+hash keeping "Polar bear" and "Polar_bear" apart) at once and atomically, so
+an interrupted study run again skips what is done, across worlds; a trial that
 raises is recorded with its error as the reason and does not stop the rest.
+``DIR/settings.json`` records the study's settings; a resume with other
+settings is refused (:class:`StudyError`).
 """
 
 from __future__ import annotations
 
 import csv
+import hashlib
+import io
 import json
 import os
+import re
+import tempfile
 import time
 import traceback
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from sim.experiments.metrics import oracle_ratio, spl
 from sim.experiments.trial import TrialParams
 from sim.world.data import World
 
-CSV_FIELDS = ["goal", "seed", "perception", "success", "reason", "distance_m", "sim_s", "wall_s"]
+CSV_FIELDS = ["world", "style", "signage", "navigator", "goal", "seed", "perception", "success", "reason",
+              "distance_m", "oracle_m", "spl", "sim_s", "wall_s", "cpu_s"]
+SETTINGS_FILE = "settings.json"
+SETTINGS_FORMAT = "abstract-map-study/2"
+
+
+class StudyError(ValueError):
+    """A study folder that cannot be used for the study asked for."""
+
+
+def slug(text: str, limit: int = 40) -> str:
+    """A file-name-safe form of ``text``: letters, digits, '.', '-' and '_' only, never empty or dots alone."""
+    cleaned = re.sub(r"[^A-Za-z0-9._-]+", "_", text).strip("._")[:limit]
+    return cleaned or "_"
 
 
 @dataclass(frozen=True)
 class TrialSpec:
-    """Everything one worker needs to run one trial (picklable)."""
+    """Everything one worker needs to run one trial and label its record (picklable)."""
 
     world: str  # path of the world folder
     goal: str
     seed: int
     perception: str
     params: TrialParams
+    navigator: str = "paper"
+    world_name: str = ""  # the world's name (default: the folder's name)
+    oracle_m: float | None = None  # m, the oracle's length from the (un-jittered) start
+    style: str = ""  # a generated world's style and signage level ("" for others)
+    signage: str = ""
+
+    @property
+    def name(self) -> str:
+        return self.world_name or Path(self.world).name
 
     @property
     def key(self) -> str:
-        return f"{self.goal.replace(' ', '_')}-{self.seed}"
+        """The trial's file, relative to ``trials/``: safe and unique per (world, navigator, goal, seed)."""
+        identity = json.dumps([self.name, self.navigator, self.goal, self.seed])
+        digest = hashlib.sha1(identity.encode()).hexdigest()[:8]
+        return f"{slug(self.name, 80)}/{slug(self.navigator, 20)}-{slug(self.goal)}-{self.seed}-{digest}"
 
 
 def study_params(perception: str, base: TrialParams | None = None) -> TrialParams:
@@ -56,12 +90,25 @@ def run_spec(spec: TrialSpec) -> dict[str, Any]:
     try:
         from sim.experiments.trial import run_trial
 
-        result = run_trial(spec.world, spec.goal, seed=spec.seed, perception=spec.perception, params=spec.params)
-        return result.to_dict()
+        result = run_trial(spec.world, spec.goal, seed=spec.seed, perception=spec.perception,
+                           navigator=spec.navigator, params=spec.params)
+        record = result.to_dict()
     except Exception as exc:  # a failed trial is data, not a crash of the study
-        return {"goal": spec.goal, "seed": spec.seed, "perception": spec.perception, "success": False,
-                "reason": f"error: {type(exc).__name__}: {exc}", "distance_m": float("nan"), "sim_s": 0.0,
-                "wall_s": round(time.perf_counter() - began, 2), "traceback": traceback.format_exc()}
+        record = {"goal": spec.goal, "seed": spec.seed, "perception": spec.perception, "success": False,
+                  "reason": f"error: {type(exc).__name__}: {exc}", "distance_m": None, "sim_s": 0.0,
+                  "wall_s": round(time.perf_counter() - began, 2), "traceback": traceback.format_exc()}
+    return label_record(record, spec)
+
+
+def label_record(record: dict[str, Any], spec: TrialSpec) -> dict[str, Any]:
+    """The record with its study key and scores: world, navigator, style, signage, oracle_m, spl, ratio."""
+    distance = record.get("distance_m")
+    score = spl(record["success"], distance, spec.oracle_m)
+    ratio = oracle_ratio(record["success"], distance, spec.oracle_m)
+    return {**record, "world": spec.name, "navigator": spec.navigator, "style": spec.style,
+            "signage": spec.signage, "oracle_m": spec.oracle_m,
+            "spl": None if score is None else round(score, 4),
+            "oracle_ratio": None if ratio is None else round(ratio, 4)}
 
 
 class ProcessExecutor:
@@ -122,42 +169,121 @@ def make_executor(name: str, workers: int, address: str | None = None) -> Proces
 
 
 def plan_specs(world: World, trials: int, perception: str, *, base: TrialParams | None = None,
-               goals: Iterable[str] | None = None) -> list[TrialSpec]:
-    """Every goal x ``trials`` seeds, goals in the world's order."""
+               goals: Iterable[str] | None = None, navigators: Iterable[str] = ("paper",),
+               oracle_m: dict[str, float] | None = None) -> list[TrialSpec]:
+    """Every goal x navigator x ``trials`` seeds of one world, goals in the world's order."""
     params = study_params(perception, base)
-    chosen = list(goals) if goals is not None else list(world.goals)
-    return [TrialSpec(str(world.root), goal, seed, perception, params) for goal in chosen for seed in range(trials)]
+    chosen = list(dict.fromkeys(goals)) if goals is not None else list(world.goals)
+    made = world.generator or {}
+    oracle_m = oracle_m or {}
+    return [TrialSpec(str(world.root), goal, seed, perception, params, navigator=navigator, world_name=world.name,
+                      oracle_m=oracle_m.get(goal), style=str(made.get("style", "")),
+                      signage=str(made.get("signage", "")))
+            for goal in chosen for navigator in dict.fromkeys(navigators) for seed in range(trials)]
 
 
-def _write_atomic(path: Path, text: str) -> None:
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+def world_oracles(world: World, goals: Iterable[str]) -> dict[str, float]:
+    """The oracle's length (m) per goal: from world.json's ``oracle_m`` when it has them, else searched."""
+    wanted = list(dict.fromkeys(goals))
+    stored = world.oracle_m or {}
+    if all(goal in stored for goal in wanted):
+        return {goal: stored[goal] for goal in wanted}
+    from sim.world.oracle import oracle_paths
+
+    return {goal: path.length_m for goal, path in oracle_paths(world, wanted).items()}
 
 
-def run_study(world: World, specs: list[TrialSpec], out: Path, *, executor: ProcessExecutor | RayExecutor,
+@dataclass(frozen=True)
+class StudySettings:
+    """What a study folder's trials were run with; a resume must ask for the same."""
+
+    worlds: tuple[str, ...]  # the --world specs as given
+    perception: str
+    navigators: tuple[str, ...]
+    trials: int  # per goal and navigator
+    goals: tuple[str, ...] | None = None  # None: every goal of every world
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"format": SETTINGS_FORMAT, **json.loads(json.dumps(asdict(self)))}
+
+
+def check_settings(out: Path, settings: StudySettings, *, record: bool = True) -> None:
+    """Record ``settings`` in a new study folder (unless not ``record``), or raise :class:`StudyError` if
+    the folder holds another study's."""
+    path = out / SETTINGS_FILE
+    wanted = settings.to_dict()
+    if path.exists():
+        try:
+            recorded = json.loads(path.read_text())
+        except (OSError, ValueError) as exc:
+            raise StudyError(f"{path}: unreadable ({exc}); use another --out") from None
+        if recorded != wanted:
+            differ = [k for k in wanted if recorded.get(k) != wanted[k]]
+            shown = "; ".join(f"{k} {recorded.get(k)!r} there, {wanted[k]!r} here" for k in differ)
+            raise StudyError(f"{out} holds a study with other settings ({shown}); "
+                             "resume it with the same settings or use another --out")
+        return
+    if record:
+        write_atomic(path, json.dumps(wanted, indent=1))
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` by a temporary file beside it and a rename: never half-written."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(handle, "w") as stream:
+            stream.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _load_record(path: Path, spec: TrialSpec) -> dict[str, Any] | None:
+    """The finished record of ``spec`` at ``path``, or None when missing, unreadable or another trial's."""
+    try:
+        record = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(record, dict) or "success" not in record:
+        return None
+    mine = (spec.name, spec.navigator, spec.goal, spec.seed)
+    return record if (record.get("world"), record.get("navigator"), record.get("goal"), record.get("seed")) == mine \
+        else None
+
+
+def run_study(specs: list[TrialSpec], out: Path, *, executor: ProcessExecutor | RayExecutor,
               progress: Callable[[int, int, dict[str, Any] | None], None] | None = None) -> list[dict[str, Any]]:
-    """Run the specs not yet done in ``out/trials``; return every trial's record (done before or now)."""
+    """Run the specs not yet done in ``out/trials``; return every trial's record (done before or now).
+
+    Also writes ``out/trials.csv``, one row per trial.
+    """
+    specs = list({s.key: s for s in specs}.values())
     folder = out / "trials"
-    folder.mkdir(parents=True, exist_ok=True)
-    todo = [s for s in specs if not (folder / f"{s.key}.json").exists()]
-    done = len(specs) - len(todo)
+    records: dict[str, dict[str, Any]] = {}
+    for spec in specs:
+        found = _load_record(folder / f"{spec.key}.json", spec)
+        if found is not None:
+            records[spec.key] = found
+    todo = [s for s in specs if s.key not in records]
     if progress:
-        progress(done, len(specs), None)
+        progress(len(records), len(specs), None)
     for spec, record in executor.map_unordered(run_spec, todo):
-        _write_atomic(folder / f"{spec.key}.json", json.dumps(record))
-        done += 1
+        write_atomic(folder / f"{spec.key}.json", json.dumps(record))
+        records[spec.key] = record
         if progress:
-            progress(done, len(specs), record)
-    records = [json.loads((folder / f"{s.key}.json").read_text()) for s in specs]
-    write_csv(records, out / "trials.csv")
-    return records
+            progress(len(records), len(specs), record)
+    ordered = [records[s.key] for s in specs]
+    write_csv(ordered, out / "trials.csv")
+    return ordered
 
 
 def write_csv(records: list[dict[str, Any]], path: Path) -> None:
-    with path.open("w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=CSV_FIELDS, extrasaction="ignore")
-        writer.writeheader()
-        for record in sorted(records, key=lambda r: (r["goal"], r["seed"])):
-            writer.writerow({k: record.get(k) for k in CSV_FIELDS})
-
+    """One row per trial (:data:`CSV_FIELDS`), sorted by world, navigator, goal and seed."""
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=CSV_FIELDS, extrasaction="ignore", lineterminator="\n")
+    writer.writeheader()
+    for record in sorted(records, key=lambda r: (r.get("world", ""), r.get("navigator", ""), r["goal"], r["seed"])):
+        writer.writerow({k: record.get(k) for k in CSV_FIELDS})
+    write_atomic(path, buffer.getvalue())

@@ -1,90 +1,98 @@
-"""Run every goal of a world N times, and compare with the paper's humans and robot.
+"""Run every goal of one or more worlds N times per navigator; report success, SPL and the paper's comparison.
 
-Example:
+Examples:
   abstract-map study --world zoo --trials 5 --out runs/study
+  abstract-map study --world generated:0-11 --trials 1 --perception geometric --navigator paper,frontier --out runs/dev
+  abstract-map study --world generated:1000-1009:style=hospital,signage=sparse --world zoo --out runs/mixed
   abstract-map study --world zoo --trials 200 --executor ray --address auto --out runs/big
 
-Trials differ by seed: start-pose jitter (0.10 m, 3 deg), the recovery's
-turning direction and, in geometric mode, detection noise (0.03 m, 1 deg).
-Writes DIR/trials.csv (one row per trial), DIR/report.md (the paper's Table I
-extended with our mean and spread, the oracle and our ratio to it),
-DIR/comparison.png (box plots like the paper's Fig. 11) and DIR/paths/GOAL.png.
-A study run again on the same DIR skips the trials already finished there.
+--world (repeatable): a world name under worlds/, a world folder, or generated:A-B[:key=value,...]
+with keys style (office, hospital, museum, campus), size (small, medium, large; default medium) and
+signage (complete, sparse, misleading). Unless fixed, style and signage cycle with the seed: seed s is
+style number s % 4 and signage level number (s // 4) % 3 in those lists, so any 12 consecutive seeds
+cover every pair (with one fixed, the other cycles by s % its count). Generated worlds are written to
+DIR/worlds/. Seeds 0-999 are for development; 1000-1999 are test buildings, for reporting only.
+
+Trials differ by seed: start-pose jitter (0.10 m, 3 deg), the recovery's turning direction and, in
+geometric mode, detection noise (0.03 m, 1 deg). Writes DIR/settings.json, DIR/trials/ (one JSON per
+trial), DIR/trials.csv (world, style, signage, navigator, goal, seed, perception, success, reason,
+distance_m, oracle_m, spl, sim_s, wall_s, cpu_s), DIR/report.md (success rate, SPL, ratio to the oracle and
+failures by reason: overall, per navigator, style, signage level and world; the ten worst trials with
+pictures in DIR/worst/) and, for the zoo, the paper's Table I extended, DIR/comparison.png (box plots
+like the paper's Fig. 11) and DIR/paths/GOAL.png. Run again on the same DIR to resume (across worlds):
+finished trials are skipped; other settings on the same DIR are refused.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
-import shutil
 import sys
-import time
 from pathlib import Path
 from typing import Any
 
 from abstract_map.cli import ExitError
 
-SUMMARY = "run every goal of a world N times and compare with the paper (needs [sim])"
+SUMMARY = "run every goal of one or more worlds N times per navigator and report (needs [sim])"
 EXTRA = "sim"  # the optional dependencies it needs
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--world", default="zoo", help="a world folder or a name under worlds/ (default: zoo)")
-    parser.add_argument("--trials", type=int, default=5, help="trials per goal (default 5)")
+    parser.add_argument("--world", action="append", metavar="SPEC",
+                        help="a world name, a world folder or generated:A-B[:style=..,size=..,signage=..]; "
+                             "repeatable (default: zoo)")
+    parser.add_argument("--trials", type=int, default=5, help="trials per goal and navigator (default 5)")
+    parser.add_argument("--navigator", action="append", metavar="NAME",
+                        help="paper (default; the paper's robot) and/or frontier (reads no sign); "
+                             "repeatable or a comma list, to compare them side by side")
     parser.add_argument("--workers", type=int, default=2, help="parallel trials (default 2)")
     parser.add_argument("--perception", default="camera", choices=["camera", "geometric"])
-    parser.add_argument("--goals", nargs="+", help="only these goals (default: every goal of the world)")
+    parser.add_argument("--goals", nargs="+", help="only these goals (default: every goal of every world)")
     parser.add_argument("--executor", default="process", choices=["process", "ray"],
                         help="local process pool (default) or Ray (needs the [ray] extra)")
     parser.add_argument("--address", help="Ray cluster address (with --executor ray); default: a local Ray")
     parser.add_argument("--out", type=Path, required=True, help="output folder (re-use it to resume)")
 
 
+def navigator_list(values: list[str] | None) -> tuple[str, ...]:
+    """``--navigator`` values, repeated or comma-separated, in order, without repeats (default: paper)."""
+    names = [n.strip() for value in (values or ["paper"]) for n in value.split(",") if n.strip()]
+    return tuple(dict.fromkeys(names))
+
+
 def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    from sim.experiments.report import comparison_plot, goal_rows, path_pictures, report_markdown
-    from sim.experiments.study import make_executor, plan_specs, run_study
-    from sim.world.data import WorldError, load_world
-    from sim.world.oracle import oracle_path
+    from sim.experiments.study import StudySettings
+    from sim.experiments.study_run import conduct_study
 
     if args.trials < 1 or args.workers < 1:
         raise ExitError("--trials and --workers must be at least 1")
-    try:
-        world = load_world(args.world)
-        unknown = [g for g in (args.goals or []) if g not in world.goals]
-        if unknown:
-            raise ExitError(f"unknown goal(s) {unknown}; goals of {world.name}: {sorted(world.goals)}")
-        executor = make_executor(args.executor, args.workers, args.address)
-    except (WorldError, ValueError) as exc:
-        raise ExitError(str(exc)) from exc
-    specs = plan_specs(world, args.trials, args.perception, goals=args.goals)
-    began = time.perf_counter()
-    bar = tqdm(total=len(specs), unit="trial", file=sys.stderr, dynamic_ncols=True)
+    settings = StudySettings(worlds=tuple(args.world or ["zoo"]), perception=args.perception,
+                             navigators=navigator_list(args.navigator), trials=args.trials,
+                             goals=tuple(args.goals) if args.goals else None)
+    bars: list[Any] = []  # made at the first progress call, so a bad argument prints its one line alone
 
     def progress(done: int, total: int, record: dict[str, Any] | None) -> None:
-        bar.n = done
+        if not bars:
+            bars.append(tqdm(total=total, unit="trial", file=sys.stderr, dynamic_ncols=True))
+        bar = bars[0]
+        bar.total, bar.n = total, done
         if record is not None:
             verdict = f"{record['distance_m']:.1f} m" if record["success"] else "FAILED"
-            bar.set_postfix_str(f"{record['goal']} seed {record['seed']}: {verdict}")
+            bar.set_postfix_str(f"{record.get('world', '')} {record.get('navigator', '')} {record['goal']} "
+                                f"seed {record['seed']}: {verdict}")
         bar.refresh()
 
-    records = run_study(world, specs, args.out, executor=executor, progress=progress)
-    bar.close()
-    wall = time.perf_counter() - began
-    oracles = {goal: oracle_path(world, goal) for goal in dict.fromkeys(s.goal for s in specs)}
-    rows = goal_rows(world, records, oracles)
-    (args.out / "report.md").write_text(report_markdown(world, rows, perception=args.perception,
-                                                        trials=args.trials, wall_s=wall))
-    comparison_plot(rows, args.out / "comparison.png")
-    path_pictures(world, records, oracles, args.out / "paths")
-    (args.out / "study.json").write_text(json.dumps({"world": world.name, "trials": args.trials,
-                                                     "perception": args.perception, "workers": args.workers,
-                                                     "executor": args.executor, "wall_s": round(wall, 1)}))
-    reference = world.root / "paper_trials.csv"
-    if reference.exists():
-        shutil.copyfile(reference, args.out / "paper_trials.csv")
-    print((args.out / "report.md").read_text(), file=sys.stderr)
+    try:
+        outcome = conduct_study(settings, args.out, workers=args.workers, executor=args.executor,
+                                address=args.address, progress=progress)
+    except ValueError as exc:  # StudyError, WorldSpecError, WorldError: bad input, one line
+        raise ExitError(str(exc)) from exc
+    finally:
+        for bar in bars:
+            bar.close()
+    print(outcome.report, file=sys.stderr)
+    records = outcome.records
     failed = sum(1 for r in records if not r["success"])
     print(f"{len(records) - failed}/{len(records)} trials found their goal; wrote {args.out}/", file=sys.stderr)
     return 0

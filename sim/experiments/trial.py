@@ -26,11 +26,11 @@ from sim.navigation.policies import PolicyParams, make_policy
 from sim.navigation.replanner import ReplanParams
 from sim.navigation.targeting import TargetParams
 from sim.navigation.viewpoints import ViewpointParams
-from sim.perception import GeometricParams, Sighting, make_perception
+from sim.perception import PERCEPTION_MODES, GeometricParams, Sighting, make_perception
 from sim.perception.laser import LaserParams, laser_angles, scan
 from sim.world.data import World, load_world
 from sim.world.robot import Robot, RobotParams
-from sim.world.scene import build_scene
+from sim.world.scene import SceneParams, build_scene
 
 
 @dataclass(frozen=True)
@@ -96,6 +96,8 @@ class TrialResult:
     settle_median_ms: float
     frames: list[Frame] = field(default_factory=list, repr=False)
     grid_extent: tuple[float, float, float, float] | None = None
+    navigator: str = "paper"  # the navigation policy's name (sim.navigation.policies.NAVIGATORS)
+    cpu_s: float = math.nan  # s of this process's CPU time: unlike wall time, not stretched by a busy machine
 
     @property
     def realtime_factor(self) -> float:
@@ -105,8 +107,9 @@ class TrialResult:
     def to_dict(self) -> dict[str, Any]:
         return {
             "world": self.world, "goal": self.goal, "seed": self.seed, "perception": self.perception,
+            "navigator": self.navigator,
             "success": self.success, "reason": self.reason, "distance_m": round(self.distance_m, 3),
-            "sim_s": round(self.sim_s, 2), "wall_s": round(self.wall_s, 2),
+            "sim_s": round(self.sim_s, 2), "wall_s": round(self.wall_s, 2), "cpu_s": round(self.cpu_s, 2),
             "realtime_factor": round(self.realtime_factor, 2), "start": list(self.start),
             "cues": [asdict(c) for c in self.cues],
             "exploration_bumps": self.exploration_bumps, "settle_median_ms": round(self.settle_median_ms, 2),
@@ -146,6 +149,7 @@ class Trial:
                  navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
                  record: bool = False) -> None:
         self.began = time.perf_counter()
+        self.began_cpu = time.process_time()
         self.world = load_world(world) if isinstance(world, str) else world
         self.params = params = params or TrialParams()
         if goal not in self.world.goals and not self.world.label_tags(goal):
@@ -156,7 +160,8 @@ class Trial:
         self.observers: list[Observer] = []
         self.rng = rng = np.random.default_rng(seed)
         self.start = _start_pose(self.world, params, rng)
-        self.scene = scene = build_scene(self.world)
+        renders = getattr(PERCEPTION_MODES.get(perception), "renders", True)  # skip the looks when nothing renders
+        self.scene = scene = build_scene(self.world, params=SceneParams(visuals=renders))
         try:
             self.robot = Robot(scene, params=RobotParams(odometry_noise_m=params.odometry_noise_m), rng=rng)
             self.robot.reset(*self.start)
@@ -277,7 +282,7 @@ class Trial:
             start=self.start, cues=self.policy.cues, trajectory=np.array(trajectory),
             final_positions=self.policy.picture()[0], exploration_bumps=getattr(self.policy, "bumps", 0),
             settle_median_ms=float(np.median(settle_ms)) if settle_ms else 0.0, frames=frames,
-            grid_extent=self.grid.extent,
+            grid_extent=self.grid.extent, navigator=self.navigator, cpu_s=time.process_time() - self.began_cpu,
         )
 
 

@@ -3,6 +3,7 @@
 Example:
   abstract-map trial --world zoo --goal Lion --out runs/lion
   abstract-map trial --world zoo --goal Toilets --perception geometric --seed 3 --out runs/t3 --record
+  abstract-map trial --world zoo --goal Lion --navigator frontier --perception geometric --out runs/f
   abstract-map trial --world zoo --goal Lion --navigator viewpoint --out runs/lion-viewpoint --record
 
 Prints a live progress line (simulated time, distance, cues read), then writes
@@ -35,7 +36,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--perception", default="camera", choices=["camera", "geometric"],
                         help="rendered camera + OpenCV AprilTag detector, or the fast geometric check")
     parser.add_argument("--navigator", default="paper",
-                        help="navigation policy: paper (the paper's robot, default) or viewpoint (negative "
+                        help="navigation policy: paper (the paper's robot, reads signs; default), frontier "
+                             "(nearest frontier, reads no sign: the no-signs lower bound) or viewpoint (negative "
                              "information: to where the goal's label may still be read)")
     parser.add_argument("--out", type=Path, required=True, help="output folder")
     parser.add_argument("--record", action="store_true", help="also write DIR/run.gif, an animation of the run")
@@ -50,13 +52,12 @@ def run(args: argparse.Namespace) -> int:
     from sim.navigation.policies import NAVIGATORS
     from sim.world.data import WorldError, load_world
 
-    if args.navigator not in NAVIGATORS:
-        raise ExitError(f"--navigator {args.navigator!r}: expected one of {', '.join(sorted(NAVIGATORS))}")
-
     try:
         world = load_world(args.world)
     except WorldError as exc:
         raise ExitError(str(exc)) from exc
+    if args.navigator not in NAVIGATORS:
+        raise ExitError(f"--navigator {args.navigator!r}: expected one of {', '.join(NAVIGATORS)}")
     params = TrialParams()
     if args.max_sim_s is not None:
         params = replace(params, max_sim_s=args.max_sim_s)

@@ -56,6 +56,7 @@ class OccupancyGrid:
         cols = int(math.ceil((x_max - x_min) / res - 1e-9))
         rows = int(math.ceil((y_max - y_min) / res - 1e-9))
         self.log_odds = np.zeros((rows, cols), dtype=np.float32)
+        self.version = 0  # counts changes (scans integrated); code editing log_odds directly bumps it too
 
     @property
     def resolution(self) -> float:
@@ -147,23 +148,37 @@ class OccupancyGrid:
         before_end = np.where(hit[:, None], d[None, :] < reach[:, None], d[None, :] <= reach[:, None])
         px = x + direction[:, 0:1] * d[None, :]
         py = y + direction[:, 1:2] * d[None, :]
-        free_cells = self._flat_indices(px[before_end], py[before_end])
+        free_r, free_c = self._cells_where(px, py, before_end)
         # Nudge hit points slightly along the beam so a hit on a cell face lands in the far cell.
         end = np.array([x, y]) + direction[hit] * (reach[hit] + 0.05 * self.resolution)[:, None]
-        hit_cells = self._flat_indices(end[:, 0], end[:, 1])
-
-        hit_cells = np.unique(hit_cells)
-        free_cells = np.setdiff1d(np.unique(free_cells), hit_cells, assume_unique=True)
-        flat = self.log_odds.reshape(-1)
+        hit_r, hit_c = self._cells_where(end[:, 0], end[:, 1], np.ones(len(end), dtype=bool))
+        if free_r.size + hit_r.size == 0:
+            return
+        # Mark the cells in a window around the scan (one update per cell; hit wins over free), then update.
+        all_r, all_c = np.concatenate([free_r, hit_r]), np.concatenate([free_c, hit_c])
+        r0, r1 = all_r.min(), all_r.max() + 1
+        c0, c1 = all_c.min(), all_c.max() + 1
+        mark = np.zeros((r1 - r0, c1 - c0), dtype=np.int8)
+        mark[free_r - r0, free_c - c0] = 1
+        mark[hit_r - r0, hit_c - c0] = 2
+        window = self.log_odds[r0:r1, c0:c1]
         lo, hi = self.params.clamp
-        flat[free_cells] = np.maximum(flat[free_cells] + self.params.l_free, lo)
-        flat[hit_cells] = np.minimum(flat[hit_cells] + self.params.l_occ, hi)
+        free, occupied = mark == 1, mark == 2
+        window[free] = np.maximum(window[free] + self.params.l_free, lo)
+        window[occupied] = np.minimum(window[occupied] + self.params.l_occ, hi)
+        self.version += 1
 
-    def _flat_indices(self, px: np.ndarray, py: np.ndarray) -> np.ndarray:
-        """Flat indices of the in-bounds cells holding world points (px, py)."""
-        rc = self.world_to_cell(np.stack([px, py], axis=1))
-        rc = rc[self.in_bounds(rc)]
-        return rc[:, 0] * self.shape[1] + rc[:, 1]
+    def _cells_where(self, px: np.ndarray, py: np.ndarray, where: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(rows, cols) of the in-bounds cells holding the world points (px, py) (m) selected by ``where``.
+
+        The same cells as :meth:`world_to_cell` gives, computed on the arrays as they are (no stacking).
+        """
+        x0, y0 = self.origin
+        rows, cols = self.shape
+        col = np.floor((px - x0) / self.resolution).astype(int)
+        row_up = np.floor((py - y0) / self.resolution).astype(int)
+        keep = where & (col >= 0) & (col < cols) & (row_up >= 0) & (row_up < rows)
+        return rows - 1 - row_up[keep], col[keep]
 
     def occupied_mask(self) -> np.ndarray:
         """Bool (rows, cols): cells believed occupied."""
@@ -197,4 +212,5 @@ class OccupancyGrid:
         other = OccupancyGrid.__new__(OccupancyGrid)
         other.params = self.params
         other.log_odds = self.log_odds.copy()
+        other.version = self.version
         return other

@@ -8,6 +8,9 @@ differs is where it wants to go. Register a new one in :data:`NAVIGATORS`.
 - ``paper``: the paper's robot: drive to the goal's imagined position in the
   abstract map (or a stand-in target when that lies behind walls), grow the
   model when the goal is not there.
+- ``frontier``: the no-signs lower bound: reads no sign, drives to the nearest
+  reachable frontier (by path length) until the goal's label comes into view,
+  and gives up when no frontier is left.
 - ``viewpoint``: negative information and readable viewpoints: a belief over
   where the goal's label hangs (the abstract map's imagined goal as its prior,
   ruled out where the camera has swept), driven to the reachable viewpoint that
@@ -18,6 +21,7 @@ differs is where it wants to go. Register a new one in :data:`NAVIGATORS`.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Protocol
@@ -28,6 +32,7 @@ from abstract_map.model import imagined_positions
 from sim.mapping.occupancy import OccupancyGrid
 from sim.navigation.belief import Belief, BeliefParams, SweptSpace, cue_mass, goal_belief, goal_sigma
 from sim.navigation.follower import FollowerParams, PathFollower, Recovery, RecoveryParams, StuckDetector, StuckParams
+from sim.navigation.frontier import FrontierParams, look, nearest_frontier, still_frontier
 from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
 from sim.navigation.planner import Plan, PlannerParams
 from sim.navigation.replanner import Replanner, ReplanParams
@@ -157,6 +162,69 @@ class PaperPolicy:
         return [s.wall_s * 1000 for s in settles[1:]] or [settles[0].wall_s * 1000]
 
 
+class FrontierPolicy:
+    """Explore without reading signs: the nearest reachable frontier, until the goal's label is read.
+
+    The trial judges success from the goal's label, so this policy ignores every
+    sighting. Space counts as explored once looked at from within reading range
+    (:func:`sim.navigation.frontier.look`), not merely swept by the 8 m laser. A
+    frontier target is dropped when it is reached, found unreachable or no longer
+    on a frontier; a reached or unreachable one is never chosen again.
+    """
+
+    def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams,
+                 frontier: FrontierParams | None = None) -> None:
+        self.params = params
+        self.frontier = frontier or FrontierParams()
+        self.drive = DriveStack(params)
+        self.cues: list[CueEvent] = []  # reads no sign
+        self.gave_up = ""
+        self.target: np.ndarray | None = None
+        self.checked_at = -float("inf")
+        self.visited: list[np.ndarray] = []
+        self.covered: np.ndarray | None = None  # bool, the grid's shape: cells looked at from within reading range
+
+    def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
+                grid: OccupancyGrid) -> None:
+        """Signs are not read: nothing to take in."""
+
+    def _choose(self, pose: Pose, grid: OccupancyGrid) -> None:
+        radius = self.params.planner.robot_radius_m
+        self.target = nearest_frontier(grid, np.array(pose[:2]), radius, self.frontier, self.visited, self.covered)
+        if self.target is None:
+            self.gave_up = "no frontier left: explored all it could reach without reading the goal's label"
+        self.drive.replanner.request()
+
+    def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
+                rng: np.random.Generator) -> tuple[float, float]:
+        radius = self.params.planner.robot_radius_m
+        if self.covered is None or self.covered.shape != grid.shape:
+            self.covered = np.zeros(grid.shape, dtype=bool)
+        look(grid, self.covered, np.array(pose[:2]), self.frontier)
+        if self.target is not None and t_s - self.checked_at >= self.frontier.recheck_s:
+            self.checked_at = t_s
+            if not still_frontier(grid, self.target, radius, self.frontier, self.covered):
+                self.target = None
+        if self.target is None:
+            self._choose(pose, grid)
+            self.checked_at = t_s
+            if self.target is None:
+                return 0.0, 0.0
+        v, w, arrived = self.drive.drive(t_s, pose, grid, self.target, tick_s, self.params.navigator.arrive_m, rng)
+        if arrived:
+            self.visited.append(self.target)
+            self.target = None
+        return v, w
+
+    def picture(self) -> tuple[dict[str, tuple[float, float]], tuple[float, float], np.ndarray | None]:
+        plan = self.drive.plan
+        shown = (math.nan, math.nan) if self.target is None else (float(self.target[0]), float(self.target[1]))
+        return {}, shown, None if plan is None else plan.waypoints
+
+    def settle_ms(self) -> list[float]:
+        return []
+
+
 class ViewpointPolicy:
     """Negative information: to where the goal's label may still be read, growing the model when it is used up."""
 
@@ -258,6 +326,7 @@ class ViewpointPolicy:
 
 NAVIGATORS: dict[str, type] = {
     "paper": PaperPolicy,
+    "frontier": FrontierPolicy,
     "viewpoint": ViewpointPolicy,
 }
 """Every navigation policy by its ``--navigator`` name; each is built as ``cls(world, goal, start, params)``."""

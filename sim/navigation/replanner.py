@@ -60,13 +60,12 @@ def _densify(points: np.ndarray, step: float) -> np.ndarray:
     """Points every ``step`` m along a polyline, vertices included, in order."""
     if len(points) == 1:
         return points.copy()
-    parts = []
-    for a, b in zip(points[:-1], points[1:]):
-        n = max(1, int(math.ceil(float(np.hypot(*(b - a))) / step)))
-        s = np.linspace(0.0, 1.0, n, endpoint=False)[:, None]
-        parts.append(a[None, :] + s * (b - a)[None, :])
-    parts.append(points[-1:])
-    return np.concatenate(parts)
+    segments = np.diff(points, axis=0)
+    counts = np.maximum(1, np.ceil(np.hypot(*segments.T) / step).astype(int))
+    owner = np.repeat(np.arange(len(segments)), counts)
+    index = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    fraction = index / counts[owner]
+    return np.concatenate([points[:-1][owner] + fraction[:, None] * segments[owner], points[-1:]])
 
 
 @dataclass(frozen=True)
@@ -97,6 +96,7 @@ class Replanner:
         self._planned_at: float | None = None
         self._planned_goal: np.ndarray | None = None
         self._forced = False
+        self._clear_at: int | None = None  # the map version at which the current plan was last found clear
 
     def request(self) -> None:
         """Re-plan at the next :meth:`update` (e.g. after a recovery manoeuvre)."""
@@ -117,8 +117,12 @@ class Replanner:
             return "goal moved"
         if self.plan is None:
             return "previous attempt failed" if t - self._planned_at >= self.params.period_s else None
-        if self.params.check_blocked and path_blocked(grid, self.plan.waypoints, self.planner_params, robot):
-            return "path blocked"
+        # The part of the path ahead only shrinks as the robot follows it, so a path found clear is checked
+        # again only once the map (OccupancyGrid.version) or the plan changed.
+        if self.params.check_blocked and self._clear_at != grid.version:
+            if path_blocked(grid, self.plan.waypoints, self.planner_params, robot):
+                return "path blocked"
+            self._clear_at = grid.version
         if _distance_to_polyline(robot, self.plan.waypoints) > self.params.off_path_m:
             return "off path"
         if t - self._planned_at >= self.params.period_s:
@@ -135,6 +139,7 @@ class Replanner:
             self._planned_at = t
             self._planned_goal = as_point(goal_xy, "goal_xy")
             self._forced = False
+            self._clear_at = None
         return self.plan
 
 

@@ -153,9 +153,13 @@ class Detection:
 class CameraPerception:
     """Reads tags from rendered images of a panoramic camera on the robot."""
 
+    renders = True  # needs the scene's looks (SceneParams.visuals)
+
     def __init__(self, scene: Scene, params: CameraParams | None = None, *,
                  rng: np.random.Generator | None = None) -> None:
         prm = params or CameraParams()
+        if not scene.params.visuals:
+            raise ValueError("camera perception needs a scene built with SceneParams(visuals=True)")
         if prm.corner_refinement not in _REFINEMENT:
             raise ValueError(f"CameraParams.corner_refinement {prm.corner_refinement!r} is not one of "
                              f"{sorted(_REFINEMENT)}")

@@ -38,6 +38,8 @@ class GeometricParams:
 class GeometricPerception:
     """Reads tags by geometry: true tag poses (plus optional noise) from the world."""
 
+    renders = False  # needs no looks: the scene may be built without them (SceneParams.visuals=False)
+
     def __init__(self, scene: Scene, params: GeometricParams | None = None, *,
                  rng: np.random.Generator | None = None) -> None:
         self.scene = scene
@@ -53,6 +55,8 @@ class GeometricPerception:
         candidates = []
         for tag in self.scene.world.tags.values():
             face = self.scene.tag_poses[tag.id]
+            if abs(face.x - cx) > prm.max_range_m or abs(face.y - cy) > prm.max_range_m:
+                continue  # out of range: the cheap test first (readable() would say no too)
             if not readable(cx, cy, face.x, face.y, face.theta,
                             max_range_m=prm.max_range_m, cone_half_angle_deg=prm.cone_half_angle_deg):
                 continue

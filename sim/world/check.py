@@ -33,7 +33,7 @@ import numpy as np
 from abstract_map.clauses import Locational, Relational
 from abstract_map.grammar import Anchor, CueError, parse_cue
 from abstract_map.hierarchy import Hierarchy, HierarchyError
-from sim.world.data import Floorplan, Tag, World
+from sim.world.data import Tag, World
 from sim.world.oracle import oracle_paths
 from sim.world.truth import (
     Facts,
@@ -41,13 +41,12 @@ from sim.world.truth import (
     Routes,
     TruthParams,
     first_leg,
+    hang,
     phrase_verdict,
     place_positions,
     place_tags,
 )
 
-WALL_SNAP_M = 0.2  # m, the scene's tag_through_m and tag_snap_m: how far a tag may be drawn from its wall face
-TAG_GAP_M = 0.02  # m, the scene's tag_wall_gap_m: a tag's face in front of its wall
 ORACLE_TOLERANCE = (0.05, 0.01)  # m and fraction: a stored oracle length this close to the computed one is current
 
 
@@ -92,47 +91,6 @@ class CheckReport:
         n = len(self.failures)
         lines.append("OK: nothing fails" if n == 0 else f"FAIL: {n} finding(s) fail")
         return "\n".join(lines)
-
-
-def _occupied(plan: Floorplan, points: np.ndarray) -> np.ndarray:
-    rc = plan.world_to_pixel(points)
-    rows, cols = plan.occupied.shape
-    inside = (rc[:, 0] >= 0) & (rc[:, 0] < rows) & (rc[:, 1] >= 0) & (rc[:, 1] < cols)
-    out = np.ones(len(points), dtype=bool)  # outside the plan counts as wall
-    out[inside] = plan.occupied[rc[inside, 0], rc[inside, 1]]
-    return out
-
-
-def hang(plan: Floorplan, tag: Tag) -> tuple[Tag, str | None]:
-    """Where ``tag`` hangs, by the scene's rule on the floor plan, and what is wrong if it has no wall.
-
-    Along the tag's normal: a wall that starts within 0.2 m ahead of the drawn
-    point (the point inside it, or behind a thin wall) and ends within 0.2 m
-    after that carries the tag on its far face; failing that, a wall within
-    0.2 m behind carries it on its near face. The tag hangs ``TAG_GAP_M`` in
-    front of that face. With no such wall it stands where it is drawn.
-    """
-    n = np.array([math.cos(tag.theta), math.sin(tag.theta)])
-    origin = np.array([tag.x, tag.y])
-    step = min(0.01, plan.resolution / 2)
-    ahead = np.arange(0.0, 2 * WALL_SNAP_M + step, step)
-    occ = _occupied(plan, origin + ahead[:, None] * n)
-    face: float | None = None
-    starts = np.nonzero(occ & (ahead <= WALL_SNAP_M))[0]
-    if len(starts):
-        ends = np.nonzero(~occ[starts[0]:])[0]
-        if len(ends) and ahead[starts[0] + ends[0]] - ahead[starts[0]] <= WALL_SNAP_M:
-            face = float(ahead[starts[0] + ends[0]])
-        elif occ[0]:
-            return tag, f"inside a wall: no free face within {WALL_SNAP_M} m in front of it"
-    if face is None:
-        behind = np.arange(step, WALL_SNAP_M + step, step)
-        hits = np.nonzero(_occupied(plan, origin - behind[:, None] * n))[0]
-        if len(hits) == 0:
-            return tag, f"no wall within {WALL_SNAP_M} m behind it (it stands free)"
-        face = -float(behind[hits[0]]) + step
-    x, y = origin + (face + TAG_GAP_M) * n
-    return Tag(tag.id, float(x), float(y), tag.theta, tag.kind, tag.text), None
 
 
 def check_world(world: World, *, hierarchy: Hierarchy | None = None, params: TruthParams | None = None) -> CheckReport:

@@ -39,14 +39,14 @@ from sim.world.layout import (
     Room,
     _opening,
     _shared,
-    _side_lines,
     block_sides,
     build_layout,
 )
 from sim.world.oracle import oracle_paths
 from sim.world.signage import EXTRA_NAMES, SLACK, Sign, Writer, sign_spots
+from sim.world.signage import _tag as _sign_tag
 from sim.world.styles import SIGNAGE, SIZES, STYLES, Size, Style, lookup
-from sim.world.truth import Facts, Routes, TruthParams, arrow_direction, nearest_arrow, place_positions
+from sim.world.truth import Facts, Routes, TruthParams, arrow_direction, hang, nearest_arrow, place_positions
 
 FILES = ("world.json", "floorplan.png", "tags.json", "hierarchy.xml")
 N_TAG_IDS = 587  # AprilTag 36h11 has ids 0-586
@@ -125,9 +125,10 @@ def _hierarchy_xml(nested: dict[str, Any]) -> str:
 def _redoor(layout: Layout, room: Room, edge: tuple, rng: np.random.Generator) -> bool:
     """Give ``room`` its door onto corridor segment ``edge`` if it borders it."""
     for side, e in block_sides(room.block).items():
-        if e != edge or room.hall is not None:
+        line = layout.corridor_sides[room.block].get(side)
+        if e != edge or room.hall is not None or line is None:
             continue
-        seg = _shared(room.rect, _side_lines(layout.blocks[room.block])[side])
+        seg = _shared(room.rect, line)
         if seg is None:
             continue
         normal = {"left": (-1.0, 0.0), "right": (1.0, 0.0), "bottom": (0.0, -1.0), "top": (0.0, 1.0)}[side]
@@ -231,7 +232,8 @@ def generate(seed: int, *, style: str = "office", size: str = "medium", signage:
         tag_id = ids.pop(0)
         tags[tag_id] = Tag(tag_id, round(x, 4), round(y, 4), theta, "label", opening.place)
 
-    facts = Facts(place_positions(hierarchy, tags, params.behind_m), hierarchy, params)
+    hung = {k: hang(plan, t)[0] for k, t in tags.items()}  # where the check (and the scene) hang them
+    facts = Facts(place_positions(hierarchy, hung, params.behind_m), hierarchy, params)
     world0 = _world(world_name(seed, style, size, signage), plan, tags, layout, goal_roles)
     oracle = oracle_paths(world0, sorted(goal_roles), params=params.oracle)
 
@@ -243,12 +245,12 @@ def generate(seed: int, *, style: str = "office", size: str = "medium", signage:
     others = [g for g in goals if g not in area_only]
     n_area_only = round(level.area_only_fraction * len(others))
     area_only |= {others[k] for k in srng.permutation(len(others))[:n_area_only]}
-    spots = sign_spots(layout, plan, routes)
+    spots = sign_spots(layout, plan, routes, list(tags.values()))
     entrance, junctions = spots[:1] if spots and spots[0].node is None else [], [s for s in spots if s.node is not None]
     if level.drop_fraction > 0:
         drop = set(srng.permutation(len(junctions))[: round(level.drop_fraction * len(junctions))].tolist())
         junctions = [s for k, s in enumerate(junctions) if k not in drop]
-    writer = Writer(facts, routes, tags, srng)
+    writer = Writer(facts, routes, plan, hung, srng)
     extras_pool = sorted({r.area for r in layout.rooms} | {h.name for h in layout.halls}
                          | {w for w in hierarchy.places if hierarchy.levels()[w] == 3}
                          | {r.name for r in layout.rooms if r.name not in area_only})
@@ -280,7 +282,8 @@ def generate(seed: int, *, style: str = "office", size: str = "medium", signage:
     for sign in signs:
         tag_id = ids.pop(0)
         anchor = f"#{tag_id}"
-        facts.positions[anchor] = np.array([sign.spot.x, sign.spot.y])
+        placed = _sign_tag(sign.spot, plan)
+        facts.positions[anchor] = np.array([placed.x, placed.y])
         facts.facing[anchor] = sign.spot.theta
         writer.phrases(sign, anchor, 2)
         line = writer.in_line(sign)

@@ -36,7 +36,7 @@ DOOR_M = 1.0  # m, door width
 EXIT_M = 2.0  # m, a hall's exit onto a corridor
 DOOR_WALL_M = 2.4  # m, shortest wall that takes a door and a label beside it
 LABEL_OFFSET_M = 0.85  # m, door centre to label centre along the wall (half a door, a gap, half a tag)
-TAG_FRONT_M = 0.025  # m, a tag's centre in front of its wall face (half a pixel: on the first free row)
+TAG_FRONT_M = 0.02  # m, a tag's centre in front of its wall face (the scene's gap: it hangs where it is drawn)
 HALL_STRIP_M = 4.6  # m, depth of the row of rooms along a hall
 MIN_HALL_SIDE_M = 11.0  # m, a hall block this big on both sides gets a row of rooms
 
@@ -129,6 +129,7 @@ class Layout:
     area_of_block: dict[Node, str]
     rooms: list[Room]
     halls: list[Hall]
+    corridor_sides: dict[Node, dict[str, LineString]] = field(default_factory=dict)  # block -> side -> corridor wall
 
     def node_xy(self, node: Node) -> tuple[float, float]:
         return (self.xs[node[0]], self.ys[node[1]])
@@ -436,8 +437,21 @@ def build_layout(style: Style, size: Size, rng: np.random.Generator) -> Layout:
 
     # halls: blocks with the most corridor sides (several exits), away from the entrance block
     def corridor_sides(b: Node) -> dict[str, LineString]:
+        """The block's sides on a corridor, clipped to the corridor's length (node centre to node centre)."""
         lines = _side_lines(rects[b])
-        return {name: lines[name] for name, e in block_sides(b).items() if kept.has_edge(*e)}
+        out = {}
+        for name, e in block_sides(b).items():
+            if not kept.has_edge(*e):
+                continue
+            (i0, j0), (i1, j1) = e
+            if i0 == i1:
+                clip = box(-1.0, max(ys[j0], WALL_M), xs[-1] + 1.0, min(ys[j1], ys[-1] - WALL_M))
+            else:
+                clip = box(max(xs[i0], WALL_M), -1.0, min(xs[i1], xs[-1] - WALL_M), ys[-1] + 1.0)
+            seg = lines[name].intersection(clip)
+            if seg.geom_type == "LineString" and seg.length > 0:
+                out[name] = seg
+        return out
 
     entrance_blocks = {(entrance_line - 1, 0), (entrance_line, 0)}
     ranked = sorted(blocks, key=lambda b: (-len(corridor_sides(b)), b in entrance_blocks, float(rng.random())))
@@ -463,7 +477,8 @@ def build_layout(style: Style, size: Size, rng: np.random.Generator) -> Layout:
     width_m, height_m = xs[-1], ys[-1]
     x_e = xs[entrance_line]
     start = (x_e, WALL_M + 1.2, math.pi / 2)
-    return Layout(width_m, height_m, xs, ys, wx, wy, kept, entrance, start, rects, area_of, rooms, halls)
+    return Layout(width_m, height_m, xs, ys, wx, wy, kept, entrance, start, rects, area_of, rooms, halls,
+                  {b: corridor_sides(b) for b in blocks})
 
 
 def _resolve_edges(rooms: list[Room]) -> None:

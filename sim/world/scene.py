@@ -58,7 +58,12 @@ _HIDDEN = (1.0, 1.0, 1.0, 0.0)
 class SceneParams:
     """How the simulated building is built and stepped."""
 
-    time_step_s: float = 1.0 / 60.0  # s, physics step
+    # s, physics step: three per 0.1 s control tick. A scripted 24 s drive ends within 5 cm and 0.1 rad of
+    # where it ends at 1/60 s, at half the cost (physics was a third of a geometric trial's wall time).
+    time_step_s: float = 1.0 / 30.0
+    # Build what only cameras and the GUI see (wall tiles, tag squares, floor and wall tops). Off for perception
+    # that renders nothing: pybullet's step costs per body, and ~500 visual bodies made it ~6x slower.
+    visuals: bool = True
     gravity_mps2: float = -9.81  # m/s^2, along world z
     wall_cell_m: float = 0.06  # m, target cell of the pooled occupancy grid
     wall_simplify_cells: float = 0.35  # cells, polyline simplification tolerance
@@ -93,7 +98,8 @@ class Scene:
     """A building in its own pybullet client. Always close() it (or use it as a context manager).
 
     Attributes: ``client`` (pybullet client id), ``world``, ``params``,
-    ``wall_body_ids`` (static wall tiles: collision and visual),
+    ``wall_body_ids`` (visual-only wall tiles, shown or hidden per camera view), ``wall_collision_ids`` (the
+    walls' static collision meshes, as few as pybullet allows),
     ``wall_boxes`` ((M, 4) merged rectangles of the pooled wall grid,
     ``x_min, x_max, y_min, y_max`` in m), ``wall_segments`` ((N, 4) wall faces
     ``x0, y0, x1, y1`` in m, wall on their left), ``tag_body_ids`` (tag id ->
@@ -113,6 +119,7 @@ class Scene:
         self._rgba: dict[int, tuple[float, float, float, float]] = {}
         self._decor_ids: list[int] = []
         self.wall_body_ids: list[int] = []
+        self.wall_collision_ids: list[int] = []
         self.tag_body_ids: dict[int, int] = {}
         self.tag_poses: dict[int, TagPose] = {}
         try:
@@ -138,6 +145,8 @@ class Scene:
 
     def _add_decor(self, corners: np.ndarray, rgba: tuple[float, float, float, float]) -> None:
         """Visual-only quads (floor, wall tops) that only the GUI shows, never the cameras."""
+        if not self.params.visuals:
+            return
         for start in range(0, len(corners), _MAX_MESH_QUADS):
             visual = self._visual(quad_mesh(corners[start:start + _MAX_MESH_QUADS]), rgba)
             body = p.createMultiBody(0, -1, visual, physicsClientId=self.client)
@@ -181,24 +190,51 @@ class Scene:
         quads = wall_quads(pieces, self.world.wall_height)
         order = np.argsort(owner.ravel(), kind="stable")
         bounds = np.searchsorted(owner.ravel()[order], np.arange(len(keys) + 1))
-        for k in range(len(keys)):
+        # Collision: all walls in as few bodies as pybullet allows (its step costs per body, not per triangle).
+        for start in range(0, len(quads), _MAX_MESH_QUADS):
+            self._add_wall_collision(quad_mesh(quads[start:start + _MAX_MESH_QUADS]))
+        # Looks: one visual-only body per tile, so the cameras can be shown only the tiles in sight.
+        self._tile_origin = np.array([x0, fp.origin[1]])
+        self._tile_bodies: dict[tuple[int, int], list[int]] = {}
+        for k in range(len(keys) if params.visuals else 0):
             members = order[bounds[k]:bounds[k + 1]]
             for start in range(0, len(members), _MAX_MESH_QUADS):
-                self._add_wall_body(quad_mesh(quads[members[start:start + _MAX_MESH_QUADS]]))
+                body = self._add_wall_tile(quad_mesh(quads[members[start:start + _MAX_MESH_QUADS]]))
+                self._tile_bodies.setdefault((int(keys[k][0]), int(keys[k][1])), []).append(body)
         self._add_decor(rect_quads(self.wall_boxes, self.world.wall_height), params.top_rgba)
 
-    def _add_wall_body(self, mesh: Mesh) -> None:
+    def _add_wall_collision(self, mesh: Mesh) -> None:
         cid = self.client
         shape = p.createCollisionShape(p.GEOM_MESH, vertices=mesh.vertices.tolist(), indices=mesh.indices.tolist(),
                                        flags=p.GEOM_FORCE_CONCAVE_TRIMESH, physicsClientId=cid)
         if shape < 0:
             raise RuntimeError(f"pybullet: cannot create a wall mesh for world {self.world.name!r}")
-        body = p.createMultiBody(0, shape, self._visual(mesh, self.params.wall_rgba), physicsClientId=cid)
+        body = p.createMultiBody(0, shape, -1, physicsClientId=cid)
+        p.changeVisualShape(body, -1, rgbaColor=_HIDDEN, physicsClientId=cid)  # drawn by the tiles
         p.setCollisionFilterGroupMask(body, -1, WALL_GROUP, ROBOT_GROUP | RAY_GROUP, physicsClientId=cid)
         p.changeDynamics(body, -1, lateralFriction=self.params.wall_friction, physicsClientId=cid)
+        self.wall_collision_ids.append(body)
+
+    def _add_wall_tile(self, mesh: Mesh) -> int:
+        body = p.createMultiBody(0, -1, self._visual(mesh, self.params.wall_rgba), physicsClientId=self.client)
         self.wall_body_ids.append(body)
         self._rgba[body] = self.params.wall_rgba
         self._shown[body] = True
+        return body
+
+    def _tiles_near(self, points: np.ndarray) -> set[int]:
+        """The visual wall tiles that may hold a wall face at ``points`` (N, 2) (m).
+
+        A wall piece belongs to the tile of its middle, at most half a piece from any point on it.
+        """
+        reach = self.params.wall_piece_m / 2
+        tiles: set[int] = set()
+        for dx in (-reach, reach):
+            for dy in (-reach, reach):
+                keys = np.floor((points + [dx, dy] - self._tile_origin) / self.params.wall_tile_m).astype(int)
+                for key in set(map(tuple, keys.tolist())):
+                    tiles.update(self._tile_bodies.get(key, ()))
+        return tiles
 
     def _occupied_along(self, points: np.ndarray) -> np.ndarray:
         """Whether the pooled wall grid is occupied at world points (N, 2) (m); outside the map counts as free."""
@@ -283,13 +319,15 @@ class Scene:
         cid = self.client
         for tag in self.world.tags.values():
             pose = self._placed_pose(tag)
+            self.tag_poses[tag.id] = pose
+            if not self.params.visuals:
+                continue
             orientation = p.getQuaternionFromEuler([0, 0, pose.theta])
             body = p.createMultiBody(0, -1, self.tag_visual_shape(), basePosition=[pose.x, pose.y, pose.z],
                                      baseOrientation=orientation, physicsClientId=cid)
             p.changeVisualShape(body, -1, textureUniqueId=self.texture(tag.id), rgbaColor=[1, 1, 1, 1],
                                 physicsClientId=cid)
             self.tag_body_ids[tag.id] = body
-            self.tag_poses[tag.id] = pose
             self._rgba[body] = (1.0, 1.0, 1.0, 1.0)
             self._shown[body] = True
 
@@ -329,9 +367,11 @@ class Scene:
             hits = p.rayTestBatch(origins[start:start + _MAX_RAY_BATCH].tolist(),
                                   ends[start:start + _MAX_RAY_BATCH].tolist(),
                                   collisionFilterMask=WALL_GROUP, physicsClientId=self.client)
-            for i, hit in enumerate(hits, start):
-                if hit[0] >= 0:
-                    bodies[i], fractions[i] = hit[0], hit[2]
+            ids = np.fromiter((hit[0] for hit in hits), dtype=int, count=len(hits))
+            along = np.fromiter((hit[2] for hit in hits), dtype=float, count=len(hits))
+            hit = ids >= 0
+            bodies[start:start + len(hits)][hit] = ids[hit]
+            fractions[start:start + len(hits)][hit] = along[hit]
         return fractions, bodies
 
     def ray_fractions(self, origins: np.ndarray, ends: np.ndarray) -> np.ndarray:
@@ -354,7 +394,10 @@ class Scene:
         angles = np.linspace(0.0, 2 * math.pi, n_rays, endpoint=False)
         origins = np.tile([x, y, z], (n_rays, 1))
         ends = origins + radius_m * np.stack([np.cos(angles), np.sin(angles), np.zeros(n_rays)], axis=1)
-        seen = set(self._ray_hits(origins, ends)[1].tolist())
+        fractions = self._ray_hits(origins, ends)[0]
+        hit = fractions < 1.0
+        points = origins[hit, :2] + fractions[hit, None] * (ends[hit, :2] - origins[hit, :2])
+        seen = self._tiles_near(points)
         show = {body: body in seen for body in self.wall_body_ids}
         show.update({body: False for body in self._decor_ids})
         for tag_id, body in self.tag_body_ids.items():

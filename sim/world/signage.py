@@ -21,9 +21,10 @@ from abstract_map.hierarchy import Hierarchy
 from abstract_map.prepositions import PREPOSITIONS
 from sim.world.data import Floorplan, Tag
 from sim.world.layout import TAG_FRONT_M, Layout, Node
-from sim.world.truth import Facts, RouteField, Routes, first_leg, nearest_arrow, phrase_verdict, place_tags
+from sim.world.truth import Facts, RouteField, Routes, first_leg, hang, nearest_arrow, phrase_verdict, place_tags
 
-SLACK = 0.7  # the generator writes what is true with 70 % of the check's tolerance
+SLACK = 0.7  # the generator writes phrases true with 70 % of the check's tolerance
+ARROW_SLACK = 40.0 / 45.0  # and arrows within 40 of the 45 degrees (routes are recomputed exactly by the check)
 ARROW_ORDER = ("LEFT", "UP", "RIGHT", "DOWN")
 PHRASE_ROWS = ("past", "before", "left of", "right of", "beside", "between")
 NEARBY_M = 14.0  # m, phrases name places this close to the sign
@@ -73,8 +74,22 @@ def _wall_ok(plan: Floorplan, x: float, y: float, theta: float) -> bool:
     return bool(occ(behind).all() and not occ(front).any())
 
 
-def sign_spots(layout: Layout, plan: Floorplan, routes: Routes) -> list[SignSpot]:
-    """The entrance sign and one sign per junction (three or more corridors), where a wall takes them."""
+MIN_TAG_GAP_M = 0.6  # m, centre to centre: two tags (0.375 m wide with their quiet zones) never overlap
+
+
+def sign_spots(layout: Layout, plan: Floorplan, routes: Routes, labels: list[Tag]) -> list[SignSpot]:
+    """The entrance sign and one sign per junction (three or more corridors), where a wall takes them.
+
+    A spot needs a wall behind it, free space in front, a reading pose, and no
+    label within ``MIN_TAG_GAP_M``.
+    """
+    taken = np.array([[t.x, t.y] for t in labels]).reshape(-1, 2)
+
+    def fits(spot: SignSpot) -> bool:
+        clear = len(taken) == 0 or float(np.hypot(*(taken - [spot.x, spot.y]).T).min()) >= MIN_TAG_GAP_M
+        return clear and _wall_ok(plan, spot.x, spot.y, spot.theta) and \
+            routes.reading_pose(_tag(spot, plan)) is not None
+
     g = layout.graph
     entrance_node = min(layout.entrance)  # the end on the outer wall
     spots: list[SignSpot] = []
@@ -82,8 +97,9 @@ def sign_spots(layout: Layout, plan: Floorplan, routes: Routes) -> list[SignSpot
     half = layout.widths_x[entrance_node[0]] / 2
     for dy in (2.0, 3.0, 4.0, 1.5, 5.0):
         for side in (1, -1):
-            spot = SignSpot(x_e + side * (half - TAG_FRONT_M), y_s + dy, math.pi if side > 0 else 0.0, None)
-            if _wall_ok(plan, spot.x, spot.y, spot.theta) and routes.reading_pose(_tag(spot)) is not None:
+            spot = SignSpot(round(x_e + side * (half - TAG_FRONT_M), 4), round(y_s + dy, 4),
+                            math.pi if side > 0 else 0.0, None)
+            if fits(spot):
                 spots.append(spot)
                 break
         if spots:
@@ -94,7 +110,7 @@ def sign_spots(layout: Layout, plan: Floorplan, routes: Routes) -> list[SignSpot
             continue
         prev = paths[node][-2]
         d = np.sign(np.subtract(node, prev)).astype(float)  # lattice steps are axis-aligned
-        spot = _junction_spot(layout, plan, routes, node, d)
+        spot = _junction_spot(layout, node, d, fits)
         if spot is not None:
             spots.append(spot)
     return spots
@@ -109,28 +125,31 @@ def _shortest_paths(g, source):  # type: ignore[no-untyped-def]
     return nx.single_source_dijkstra_path(g, source, weight=length)
 
 
-def _tag(spot: SignSpot, tag_id: int = -1, text: str = "", kind: str = "sign") -> Tag:
-    return Tag(tag_id, spot.x, spot.y, spot.theta, kind, text)
+def _tag(spot: SignSpot, plan: Floorplan) -> Tag:
+    """The sign's tag where the check and the scene hang it (its written position rounded as in tags.json)."""
+    return hang(plan, Tag(-1, round(spot.x, 4), round(spot.y, 4), spot.theta, "sign", ""))[0]
 
 
-def _junction_spot(layout: Layout, plan: Floorplan, routes: Routes, node: Node, d: np.ndarray) -> SignSpot | None:
+def _junction_spot(layout: Layout, node: Node, d: np.ndarray, fits) -> SignSpot | None:  # type: ignore[no-untyped-def]
+    """A wall for the sign at ``node``: facing the arrival direction ``d`` (the T's far wall, else a corner
+    across the junction), else the far wall of the T facing its stem."""
     x, y = layout.node_xy(node)
-    vertical = d[0] == 0
-    cross_half = layout.widths_y[node[1]] / 2 if vertical else layout.widths_x[node[0]] / 2
-    along_half = layout.widths_x[node[0]] / 2 if vertical else layout.widths_y[node[1]] / 2
-    theta = math.atan2(-d[1], -d[0])
-    face = np.array([x, y]) + d * (cross_half + TAG_FRONT_M)
-    ahead = (node[0] + int(d[0]), node[1] + int(d[1]))
-    perp = np.array([-d[1], d[0]])
-    candidates = []
-    if not layout.graph.has_edge(node, ahead):
-        candidates.append(face)
-    for p in (perp, -perp):
-        for extra in (0.8, 1.6, 2.6):
-            candidates.append(face + p * (along_half + extra))
-    for c in candidates:
+    candidates: list[tuple[np.ndarray, float]] = []
+    for k, way in enumerate([d] + [np.array(m, dtype=float) for m in ((1, 0), (-1, 0), (0, 1), (0, -1))]):
+        vertical = way[0] == 0
+        cross_half = layout.widths_y[node[1]] / 2 if vertical else layout.widths_x[node[0]] / 2
+        along_half = layout.widths_x[node[0]] / 2 if vertical else layout.widths_y[node[1]] / 2
+        theta = math.atan2(-way[1], -way[0])
+        face = np.array([x, y]) + way * (cross_half + TAG_FRONT_M)
+        ahead = (node[0] + int(way[0]), node[1] + int(way[1]))
+        perp = np.array([-way[1], way[0]])
+        if not layout.graph.has_edge(node, ahead):
+            candidates += [(face + j * perp, theta) for j in (0.0, 0.7, -0.7, 1.4, -1.4, 2.1, -2.1)]
+        if k == 0:  # corners only for the arrival direction
+            candidates += [(face + p * (along_half + extra), theta) for p in (perp, -perp) for extra in (0.8, 1.4, 2.0)]
+    for c, theta in candidates:
         spot = SignSpot(round(float(c[0]), 4), round(float(c[1]), 4), theta, node)
-        if _wall_ok(plan, spot.x, spot.y, spot.theta) and routes.reading_pose(_tag(spot)) is not None:
+        if fits(spot):
             return spot
     return None
 
@@ -141,7 +160,8 @@ class Writer:
 
     facts: Facts
     routes: Routes
-    tags: dict[int, Tag]  # the labels so far
+    plan: Floorplan
+    tags: dict[int, Tag]  # the labels, where they hang
     rng: np.random.Generator
     used_rows: dict[str, int] = field(default_factory=lambda: {r: 0 for r in PHRASE_ROWS})
     used_words: dict[str, int] = field(default_factory=dict)
@@ -155,7 +175,7 @@ class Writer:
         """Add an arrow for each name that ``truth`` calls clearly true from this sign; return the names left out."""
         key = (sign.spot.x, sign.spot.y, sign.spot.theta)
         if key not in self._fields:
-            pose = self.routes.reading_pose(_tag(sign.spot))
+            pose = self.routes.reading_pose(_tag(sign.spot, self.plan))
             self._fields[key] = self.routes.field_from(pose) if pose is not None else None
         field_ = self._fields[key]
         skipped = []
@@ -169,7 +189,7 @@ class Writer:
                 skipped.append(name)
                 continue
             arrow, error = nearest_arrow(sign.spot.theta, leg)
-            if error > SLACK * self.routes.params.tolerance_deg:
+            if error > ARROW_SLACK * self.routes.params.tolerance_deg:
                 skipped.append(name)
                 continue
             sign.arrows.setdefault(arrow, []).append(name)

@@ -36,7 +36,7 @@ STYLES: dict[str, Style] = {
         rooms=("Office", "Meeting Room", "Kitchen", "Print Room", "Storeroom", "Studio", "Lab", "Library"),
         halls=("Atrium", "Lobby"),
         corridor_m=(1.8, 2.4),
-        room_m2=40.0,
+        room_m2=46.0,
         cut_fraction=0.35,
     ),
     "hospital": Style(

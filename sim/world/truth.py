@@ -24,7 +24,7 @@ Tests (``tolerance_deg`` 45 by default; F the figure, R a referent, C the contex
 
 Arrows: the reader stands ``reading_m`` in front of the sign (or, when that is
 within the robot's radius of a wall, at the first free cell farther out along
-the normal, up to the reading range). The route to a place is the shortest
+the normal, up to the reading range), at the centre of that route-grid cell. The route to a place is the shortest
 collision-free path (the oracle's distance field, robot inflated) from there to
 the nearest cell that can read a label of the place or of any place in it. Its
 first leg is the first segment of the route simplified by ``simplify_m``
@@ -47,7 +47,7 @@ from shapely.geometry import LineString
 from abstract_map.hierarchy import Hierarchy
 from abstract_map.prepositions import ARROWS, PREPOSITIONS, TABLE
 from sim.world.data import Floorplan, Tag
-from sim.world.oracle import OracleParams, distance_field, free_cells, nearest_cell, pool_plan, readable_cells
+from sim.world.oracle import OracleParams, distance_field, free_cells, pool_plan, readable_cells
 
 
 @dataclass(frozen=True)
@@ -69,6 +69,51 @@ class TruthParams:
     def oracle(self) -> OracleParams:
         return OracleParams(cell_m=self.route_cell_m, robot_radius_m=self.robot_radius_m,
                             read_range_m=self.read_range_m, cone_half_angle_deg=self.cone_half_angle_deg)
+
+
+WALL_SNAP_M = 0.2  # m, the scene's tag_through_m and tag_snap_m: how far a tag may be drawn from its wall face
+TAG_GAP_M = 0.02  # m, the scene's tag_wall_gap_m: a tag's face in front of its wall
+
+
+def _occupied(plan: Floorplan, points: np.ndarray) -> np.ndarray:
+    rc = plan.world_to_pixel(points)
+    rows, cols = plan.occupied.shape
+    inside = (rc[:, 0] >= 0) & (rc[:, 0] < rows) & (rc[:, 1] >= 0) & (rc[:, 1] < cols)
+    out = np.ones(len(points), dtype=bool)  # outside the plan counts as wall
+    out[inside] = plan.occupied[rc[inside, 0], rc[inside, 1]]
+    return out
+
+
+def hang(plan: Floorplan, tag: Tag) -> tuple[Tag, str | None]:
+    """Where ``tag`` hangs, by the scene's rule on the floor plan, and what is wrong if it has no wall.
+
+    Along the tag's normal: a wall that starts within 0.2 m ahead of the drawn
+    point (the point inside it, or behind a thin wall) and ends within 0.2 m
+    after that carries the tag on its far face; failing that, a wall within
+    0.2 m behind carries it on its near face. The tag hangs ``TAG_GAP_M`` in
+    front of that face. With no such wall it stands where it is drawn.
+    """
+    n = np.array([math.cos(tag.theta), math.sin(tag.theta)])
+    origin = np.array([tag.x, tag.y])
+    step = min(0.01, plan.resolution / 2)
+    ahead = np.arange(0.0, 2 * WALL_SNAP_M + step, step)
+    occ = _occupied(plan, origin + ahead[:, None] * n)
+    face: float | None = None
+    starts = np.nonzero(occ & (ahead <= WALL_SNAP_M))[0]
+    if len(starts):
+        ends = np.nonzero(~occ[starts[0]:])[0]
+        if len(ends) and ahead[starts[0] + ends[0]] - ahead[starts[0]] <= WALL_SNAP_M:
+            face = float(ahead[starts[0] + ends[0]])
+        elif occ[0]:
+            return tag, f"inside a wall: no free face within {WALL_SNAP_M} m in front of it"
+    if face is None:
+        behind = np.arange(step, WALL_SNAP_M + step, step)
+        hits = np.nonzero(_occupied(plan, origin - behind[:, None] * n))[0]
+        if len(hits) == 0:
+            return tag, f"no wall within {WALL_SNAP_M} m behind it (it stands free)"
+        face = -float(behind[hits[0]]) + step
+    x, y = origin + (face + TAG_GAP_M) * n
+    return Tag(tag.id, float(x), float(y), tag.theta, tag.kind, tag.text), None
 
 
 def angle_between(a: np.ndarray, b: np.ndarray) -> float:
@@ -255,13 +300,13 @@ class Routes:
         self.params = params or TruthParams()
         self.grid = pool_plan(plan, self.params.route_cell_m)
         self.free = free_cells(self.grid, self.params.robot_radius_m)
-        self._readable: dict[tuple[int, float, float, float], np.ndarray] = {}
+        self._readable: dict[tuple[int, float, float, float], np.ndarray] = {}  # tag pose -> readable free cells
 
     def readable(self, tag: Tag) -> np.ndarray:
-        """Free cells that can read ``tag`` (cached by tag pose)."""
+        """(row, col) of the free cells that can read ``tag`` (cached by tag pose)."""
         key = (tag.id, tag.x, tag.y, tag.theta)
         if key not in self._readable:
-            self._readable[key] = readable_cells(self.grid, tag, self.params.oracle) & self.free
+            self._readable[key] = np.argwhere(readable_cells(self.grid, tag, self.params.oracle) & self.free)
         return self._readable[key]
 
     def cell(self, xy: np.ndarray) -> tuple[int, int] | None:
@@ -278,8 +323,9 @@ class Routes:
         steps = [self.params.reading_m] + list(np.arange(self.params.robot_radius_m, self.params.read_range_m,
                                                          self.grid.resolution / 2))
         for s in steps:
-            if self.cell(origin + s * n) is not None:
-                return origin + s * n
+            cell = self.cell(origin + s * n)
+            if cell is not None:
+                return self.grid.pixel_to_world(np.array([cell]))[0]  # the cell's centre: robust to mm shifts
         return None
 
     def field_from(self, xy: np.ndarray) -> RouteField | None:
@@ -299,11 +345,19 @@ class RouteField:
     cumulative: np.ndarray
     mcp: object
 
+    def _nearest(self, tag: Tag) -> tuple[float, tuple[int, int]] | None:
+        cells = self.routes.readable(tag)
+        if len(cells) == 0:
+            return None
+        costs = self.cumulative[cells[:, 0], cells[:, 1]]
+        i = int(np.argmin(costs))
+        return (float(costs[i]), (int(cells[i, 0]), int(cells[i, 1]))) if np.isfinite(costs[i]) else None
+
     def route_to(self, tags: list[Tag]) -> np.ndarray | None:
         """The shortest route (N, 2) m to a cell reading any of ``tags``, or None when none is reachable."""
         best: tuple[float, tuple[int, int]] | None = None
         for tag in tags:
-            found = nearest_cell(self.cumulative, self.routes.readable(tag))
+            found = self._nearest(tag)
             if found is not None and (best is None or found[0] < best[0]):
                 best = found
         if best is None:
@@ -314,7 +368,7 @@ class RouteField:
         return path
 
     def reaches(self, tag: Tag) -> bool:
-        return nearest_cell(self.cumulative, self.routes.readable(tag)) is not None
+        return self._nearest(tag) is not None
 
 
 def first_leg(path: np.ndarray, target: np.ndarray | None, params: TruthParams) -> float | None:

@@ -30,14 +30,14 @@ def test_specs_vary_by_seed_and_carry_the_variation(tiny_world):
 
 def test_study_runs_resumes_and_writes_csv(tiny_world, tmp_path):
     specs = tiny_specs(tiny_world)
-    records = run_study(tiny_world, specs, tmp_path, executor=ProcessExecutor(1))
+    records = run_study(specs, tmp_path, executor=ProcessExecutor(1))
     assert [r["success"] for r in records] == [True, True]
     assert records[0]["start"] != records[1]["start"]  # the seeds jitter the start
     rows = list(csv.DictReader((tmp_path / "trials.csv").open()))
     assert [(r["goal"], r["seed"], r["success"]) for r in rows] == [("A", "0", "True"), ("A", "1", "True")]
     stamps = {p.name: p.stat().st_mtime_ns for p in (tmp_path / "trials").iterdir()}
     calls = []
-    run_study(tiny_world, specs, tmp_path, executor=ProcessExecutor(1),
+    run_study(specs, tmp_path, executor=ProcessExecutor(1),
               progress=lambda done, total, record: calls.append((done, total, record)))
     assert calls == [(2, 2, None)]  # nothing left to run
     assert stamps == {p.name: p.stat().st_mtime_ns for p in (tmp_path / "trials").iterdir()}
@@ -45,22 +45,22 @@ def test_study_runs_resumes_and_writes_csv(tiny_world, tmp_path):
 
 def test_a_failing_trial_is_recorded_and_the_rest_go_on(tiny_world, tmp_path):
     bad = TrialSpec(str(tiny_world.root), "Narnia", 0, "geometric", study_params("geometric"))
-    records = run_study(tiny_world, [bad, *tiny_specs(tiny_world, 1)], tmp_path, executor=ProcessExecutor(1))
+    records = run_study([bad, *tiny_specs(tiny_world, 1)], tmp_path, executor=ProcessExecutor(1))
     assert not records[0]["success"] and "Narnia" in records[0]["reason"]
     assert records[1]["success"]
 
 
 def test_process_pool_matches_serial(tiny_world, tmp_path):
     specs = tiny_specs(tiny_world)
-    serial = run_study(tiny_world, specs, tmp_path / "a", executor=ProcessExecutor(1))
-    pooled = run_study(tiny_world, specs, tmp_path / "b", executor=ProcessExecutor(2))
+    serial = run_study(specs, tmp_path / "a", executor=ProcessExecutor(1))
+    pooled = run_study(specs, tmp_path / "b", executor=ProcessExecutor(2))
     assert [r["distance_m"] for r in serial] == [r["distance_m"] for r in pooled]
 
 
 def test_ray_executor_on_a_local_instance(tiny_world, tmp_path):
     ray = pytest.importorskip("ray")
     try:
-        records = run_study(tiny_world, tiny_specs(tiny_world, 1), tmp_path, executor=make_executor("ray", 1))
+        records = run_study(tiny_specs(tiny_world, 1), tmp_path, executor=make_executor("ray", 1))
     finally:
         ray.shutdown()
     assert records[0]["success"]
@@ -117,3 +117,111 @@ def test_study_command_end_to_end(tiny_world, tmp_path):
     for name in ("trials.csv", "report.md", "comparison.png", "paths/A.png", "paper_trials.csv"):
         assert (out / name).exists(), name
     assert "| A | 3.0 | 2.5 |" in (out / "report.md").read_text()
+
+
+# -- many worlds, navigators, scores ------------------------------------------------------------------------
+
+
+def test_spl_and_ratio_follow_anderson_et_al():
+    from sim.experiments.metrics import oracle_ratio, spl
+
+    assert spl(True, 40.0, 30.0) == pytest.approx(0.75)
+    assert spl(True, 29.0, 30.0) == 1.0  # no shorter than the oracle counts as the oracle
+    assert spl(False, 10.0, 30.0) == 0.0
+    assert spl(True, 40.0, None) is None and spl(False, None, 0.0) is None
+    assert oracle_ratio(True, 45.0, 30.0) == pytest.approx(1.5)
+    assert oracle_ratio(False, 45.0, 30.0) is None
+
+
+def test_trial_files_are_safe_and_unique():
+    params = study_params("geometric")
+    specs = [TrialSpec("w", goal, 0, "geometric", params, world_name=world)
+             for goal, world in [("Polar bear", "zoo"), ("Polar_bear", "zoo"), ("../../x", "zoo"),
+                                 ("Lion", "../evil"), ("Lion", "zoo")]]
+    keys = [s.key for s in specs]
+    assert len(set(keys)) == len(keys)
+    for key in keys:
+        world_part, name = key.split("/")
+        assert ".." not in key and world_part not in ("", ".", "..") and "/" not in name and "\\" not in key
+    frontier = TrialSpec("w", "Lion", 0, "geometric", params, world_name="zoo", navigator="frontier")
+    assert frontier.key != specs[-1].key
+
+
+def settings_for(world, **changes):
+    from dataclasses import replace
+
+    from sim.experiments.study import StudySettings
+
+    return replace(StudySettings(worlds=(str(world.root),), perception="geometric", navigators=("paper",),
+                                 trials=1), **changes)
+
+
+def test_multi_world_study_resumes_across_worlds_and_refuses_other_settings(tiny_world, tmp_path):
+    from sim.experiments.study import StudyError
+    from sim.experiments.study_run import conduct_study
+
+    twin = tmp_path / "twin"
+    shutil.copytree(tiny_world.root, twin)
+    meta = (twin / "world.json").read_text().replace('"name": "tiny"', '"name": "twin"')
+    (twin / "world.json").write_text(meta)
+    settings = settings_for(tiny_world, worlds=(str(tiny_world.root), str(twin)), navigators=("paper", "frontier"))
+    out = tmp_path / "study"
+    first = conduct_study(settings, out, workers=1)
+    assert [(r["world"], r["navigator"]) for r in first.records] == [  # round robin over worlds
+        ("tiny", "paper"), ("tiny", "frontier"), ("twin", "paper"), ("twin", "frontier")]
+    assert all(r["oracle_m"] > 0 and r["spl"] is not None for r in first.records)
+    rows = list(csv.DictReader((out / "trials.csv").open()))
+    assert {"world", "navigator", "oracle_m", "spl", "goal", "seed", "distance_m", "reason"} <= set(rows[0])
+    # resume: a trial file removed is the only one run again
+    files = sorted((out / "trials").rglob("*.json"))
+    assert len(files) == 4
+    files[0].unlink()
+    calls = []
+    conduct_study(settings, out, workers=1, progress=lambda done, total, record: calls.append((done, total)))
+    assert calls == [(3, 4), (4, 4)]
+    report = (out / "report.md").read_text()
+    for section in ("## Over all trials", "### Failures by reason", "### Per world", "worst trials"):
+        assert section in report
+    with pytest.raises(StudyError, match="trials"):
+        conduct_study(settings_for(tiny_world, worlds=settings.worlds, navigators=settings.navigators, trials=2),
+                      out, workers=1)
+
+
+def test_summary_groups_scores_and_lists_the_worst(tmp_path):
+    from sim.experiments.summary import stats, summary_markdown, worst_trials
+
+    records = [
+        {"world": "a", "style": "office", "signage": "complete", "navigator": "paper", "goal": "X", "seed": 0,
+         "success": True, "distance_m": 40.0, "oracle_m": 30.0, "spl": 0.75, "oracle_ratio": 4 / 3, "wall_s": 10.0,
+         "reason": "goal label read"},
+        {"world": "a", "style": "office", "signage": "complete", "navigator": "frontier", "goal": "X", "seed": 0,
+         "success": False, "distance_m": 300.0, "oracle_m": 30.0, "spl": 0.0, "oracle_ratio": None, "wall_s": 30.0,
+         "reason": "distance cap of 300 m reached"},
+        {"world": "b", "style": "museum", "signage": "sparse", "navigator": "paper", "goal": "Y", "seed": 0,
+         "success": True, "distance_m": 20.0, "oracle_m": 20.0, "spl": 1.0, "oracle_ratio": 1.0, "wall_s": 5.0,
+         "reason": "goal label read"},
+    ]
+    paper = stats([r for r in records if r["navigator"] == "paper"])
+    assert paper["success"] == 1.0 and paper["spl"] == pytest.approx(0.875) and paper["ratio"] == pytest.approx(7 / 6)
+    worst = worst_trials(records, 2)
+    assert [r["navigator"] for r in worst] == ["frontier", "paper"] and worst[1]["spl"] == 0.75
+    text = summary_markdown(records, worst=worst, pictures=[tmp_path / "w" / "1.png", None], relative_to=tmp_path)
+    assert "### By style" in text and "### By signage level" in text
+    assert "| frontier | distance cap of N m reached | 1 |" in text
+    assert "[path](w/1.png)" in text
+    assert "| paper | 100% (2/2) | 0.88 | 1.17 |" in text
+
+
+def test_plan_goes_round_robin_over_worlds(tiny_world, tmp_path):
+    from sim.experiments.study_run import plan_study
+    from sim.world.data import load_world
+
+    twin = tmp_path / "twin"
+    shutil.copytree(tiny_world.root, twin)
+    (twin / "world.json").write_text((twin / "world.json").read_text().replace('"name": "tiny"', '"name": "twin"'))
+    settings = settings_for(tiny_world, trials=2, navigators=("paper", "frontier"))
+    specs = plan_study([tiny_world, load_world(twin)], settings)
+    assert [(s.seed, s.name, s.navigator) for s in specs] == [
+        (0, "tiny", "paper"), (0, "tiny", "frontier"), (0, "twin", "paper"), (0, "twin", "frontier"),
+        (1, "tiny", "paper"), (1, "tiny", "frontier"), (1, "twin", "paper"), (1, "twin", "frontier")]
+    assert all(s.oracle_m and s.oracle_m > 0 for s in specs)

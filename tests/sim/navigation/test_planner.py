@@ -25,6 +25,7 @@ def set_cells(grid: OccupancyGrid, x0: float, x1: float, y0: float, y1: float, o
     inside = ((centres[..., 0] >= x0) & (centres[..., 0] <= x1)
               & (centres[..., 1] >= y0) & (centres[..., 1] <= y1))
     grid.log_odds[inside] = grid.params.clamp[1] if occupied else grid.params.clamp[0]
+    grid.version += 1  # the map changed (as OccupancyGrid.integrate counts it)
 
 
 def dense(waypoints: np.ndarray, step: float = 0.01) -> np.ndarray:

@@ -43,11 +43,3 @@ def test_viewpoint_finds_every_goal_of_a_generated_building(tmp_path, style):
         result = run_trial(world, goal, perception="geometric", navigator="viewpoint")
         assert result.success, (goal, result.reason)
 
-
-def test_trial_command_rejects_an_unknown_navigator(tiny_world, tmp_path, capsys):
-    from abstract_map.cli import main
-
-    code = main(["trial", "--world", str(tiny_world.root), "--goal", "A", "--navigator", "teleport",
-                 "--out", str(tmp_path)])
-    assert code == 2
-    assert "teleport" in capsys.readouterr().err

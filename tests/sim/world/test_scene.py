@@ -92,3 +92,20 @@ def test_scenes_are_independent_clients(tiny_world):
     finally:
         first.close()
         second.close()
+
+
+def test_a_scene_without_looks_has_the_same_walls_and_tags(tiny_world, tiny_scene):
+    bare = build_scene(tiny_world, params=SceneParams(visuals=False))
+    try:
+        assert bare.wall_body_ids == [] and bare.tag_body_ids == {} and bare.wall_collision_ids
+        assert bare.tag_poses == tiny_scene.tag_poses
+        angles = np.linspace(0, 2 * math.pi, 90, endpoint=False)
+        origins = np.tile([2.0, 2.0, 0.3], (90, 1))
+        ends = origins + 8.0 * np.stack([np.cos(angles), np.sin(angles), np.zeros(90)], axis=1)
+        assert np.array_equal(bare.ray_fractions(origins, ends), tiny_scene.ray_fractions(origins, ends))
+        from sim.perception import make_perception
+
+        with pytest.raises(ValueError, match="visuals"):
+            make_perception("camera", bare)
+    finally:
+        bare.close()

@@ -1,0 +1,167 @@
+"""A study's summary over many worlds: success, SPL, ratio to the oracle and failures, by group.
+
+Groups: overall, per navigator, style, signage level and world. SPL is
+Anderson et al. (2018) (:mod:`sim.experiments.metrics`), averaged over every
+trial with a known oracle (a failure scores 0); the ratio to the oracle
+(distance / oracle) is averaged over successful trials only. The ten worst
+trials (lowest SPL, then longest) get a picture of their path.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections import Counter
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sim.experiments.pictures import draw_floorplan, draw_path, draw_tags
+from sim.world.data import World
+
+Record = dict[str, Any]
+
+
+def reason_kind(record: Record) -> str:
+    """A failure's reason without its particulars (numbers, error messages), for counting."""
+    reason = str(record.get("reason", ""))
+    if reason.startswith("error:"):
+        return ":".join(reason.split(":")[:2]).strip()
+    return re.sub(r"\d+(\.\d+)?", "N", reason.split(":")[0]).strip()
+
+
+def stats(records: list[Record]) -> dict[str, Any]:
+    """Trials, successes, success rate, mean SPL, mean ratio to the oracle, mean distance and wall time."""
+    n = len(records)
+    found = [r for r in records if r["success"]]
+    spls = [r["spl"] for r in records if r.get("spl") is not None]
+    ratios = [r["oracle_ratio"] for r in found if r.get("oracle_ratio") is not None]
+    distances = [r["distance_m"] for r in found if r.get("distance_m") is not None]
+    walls = [r["wall_s"] for r in records if r.get("wall_s") is not None]
+    cpus = [r["cpu_s"] for r in records if r.get("cpu_s") is not None and math.isfinite(r["cpu_s"])]
+    return {"trials": n, "found": len(found), "success": len(found) / n if n else math.nan,
+            "spl": float(np.mean(spls)) if spls else math.nan,
+            "ratio": float(np.mean(ratios)) if ratios else math.nan,
+            "distance": float(np.mean(distances)) if distances else math.nan,
+            "wall": float(np.mean(walls)) if walls else math.nan,
+            "cpu": float(np.mean(cpus)) if cpus else math.nan,
+            "failures": Counter(reason_kind(r) for r in records if not r["success"])}
+
+
+def _f(value: float, spec: str = ".2f") -> str:
+    return "-" if value is None or (isinstance(value, float) and math.isnan(value)) else format(value, spec)
+
+
+def _row(label: list[str], s: dict[str, Any]) -> str:
+    rate = f"{100 * s['success']:.0f}% ({s['found']}/{s['trials']})" if s["trials"] else "-"
+    return "| " + " | ".join([*label, rate, _f(s["spl"]), _f(s["ratio"]), _f(s["distance"], ".1f"),
+                              _f(s["wall"], ".1f")]) + " |"
+
+
+def grouped_table(records: list[Record], columns: list[str], key: Callable[[Record], tuple[str, ...]]) -> list[str]:
+    """A markdown table of :func:`stats` per group ``key(record)``, groups in first-seen order."""
+    groups: dict[tuple[str, ...], list[Record]] = {}
+    for record in records:
+        groups.setdefault(key(record), []).append(record)
+    lines = ["| " + " | ".join([*columns, "success", "SPL", "ratio to oracle", "distance (m)", "wall (s)"]) + " |",
+             "|" + " --- |" * (len(columns) + 5)]
+    lines += [_row(list(k), stats(v)) for k, v in sorted(groups.items())]
+    return lines
+
+
+def worst_trials(records: list[Record], n: int = 10) -> list[Record]:
+    """The ``n`` trials with the lowest SPL (unknown SPL first among failures), then the longest."""
+    def badness(r: Record) -> tuple[float, float]:
+        score = r.get("spl")
+        distance = r.get("distance_m")
+        return (-1.0 if score is None else score, -(distance if distance is not None else math.inf))
+    return sorted(records, key=badness)[:n]
+
+
+def trial_picture(record: Record, world: World, path: Path, oracle: np.ndarray | None = None) -> Path:
+    """One trial's path over the floor plan, the goal's labels gold, the oracle's path dashed (if given)."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(9, 8))
+    draw_floorplan(ax, world)
+    draw_tags(ax, world, goal_tags=[t.id for t in world.label_tags(record["goal"])])
+    if record.get("trajectory"):
+        verdict = f"{record['distance_m']:.1f} m" if record["success"] else "failed"
+        draw_path(ax, np.array(record["trajectory"]), colour="tab:green" if record["success"] else "tab:red",
+                  label=f"{record.get('navigator', '')} seed {record['seed']}: {verdict}")
+    if oracle is not None:
+        ax.plot(oracle[:, 0], oracle[:, 1], color="black", ls="--", lw=1.5, label="oracle")
+    x0, x1, y0, y1 = world.floorplan.extent
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    spl = record.get("spl")
+    ax.set_title(f"{world.name}: {record['goal']} (SPL {_f(spl)}; {record.get('reason', '')})", fontsize=9)
+    ax.legend(loc="lower right", fontsize=7)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path
+
+
+def worst_pictures(worst: list[Record], worlds: dict[str, World], folder: Path) -> list[Path | None]:
+    """A picture per worst trial in ``folder`` (None where its world is not known)."""
+    from sim.experiments.study import slug
+    from sim.world.oracle import oracle_paths
+
+    out: list[Path | None] = []
+    for i, record in enumerate(worst, 1):
+        world = worlds.get(record.get("world", ""))
+        if world is None:
+            out.append(None)
+            continue
+        try:
+            oracle = oracle_paths(world, [record["goal"]])[record["goal"]].path
+        except ValueError:
+            oracle = None
+        name = f"{i:02d}-{slug(world.name, 60)}-{slug(record.get('navigator', ''), 20)}-{slug(record['goal'])}" \
+               f"-{record['seed']}.png"
+        out.append(trial_picture(record, world, folder / name, oracle))
+    return out
+
+
+def summary_markdown(records: list[Record], *, worst: list[Record], pictures: Iterable[Path | None],
+                     relative_to: Path) -> str:
+    """The sections over all trials: overall, by style and signage, failures, per world, the ten worst."""
+    nav = lambda r: r.get("navigator", "paper")  # noqa: E731
+    generated = any(r.get("style") for r in records)
+    lines = ["## Over all trials", "",
+             "Success: goal's label read. SPL: success x oracle / max(distance, oracle) (Anderson et al. 2018), "
+             "mean over all trials. Ratio to oracle and distance: mean over successful trials. Wall: seconds per "
+             "trial.", ""]
+    lines += grouped_table(records, ["navigator"], lambda r: (nav(r),))
+    if generated:
+        lines += ["", "### By style", ""]
+        lines += grouped_table(records, ["navigator", "style"], lambda r: (nav(r), r.get("style") or "-"))
+        lines += ["", "### By signage level", ""]
+        lines += grouped_table(records, ["navigator", "signage"], lambda r: (nav(r), r.get("signage") or "-"))
+    lines += ["", "### Failures by reason", ""]
+    failures = Counter((nav(r), reason_kind(r)) for r in records if not r["success"])
+    if failures:
+        lines += ["| navigator | reason | trials |", "| --- | --- | --- |"]
+        lines += [f"| {n} | {reason} | {count} |" for (n, reason), count in sorted(failures.items())]
+    else:
+        lines.append("None: every trial found its goal.")
+    lines += ["", "### Per world", ""]
+    lines += grouped_table(records, ["world", "style", "signage", "navigator"],
+                           lambda r: (r.get("world", ""), r.get("style") or "-", r.get("signage") or "-", nav(r)))
+    lines += ["", f"### The {len(worst)} worst trials (lowest SPL)", "",
+              "| # | world | navigator | goal | seed | result | distance (m) | oracle (m) | SPL | picture |",
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for i, (record, picture) in enumerate(zip(worst, pictures), 1):
+        result = "found" if record["success"] else f"failed: {record.get('reason', '')}"
+        link = f"[path]({picture.relative_to(relative_to).as_posix()})" if picture is not None else "-"
+        lines.append(f"| {i} | {record.get('world', '')} | {nav(record)} | {record['goal']} | {record['seed']} | "
+                     f"{result} | {_f(record.get('distance_m'), '.1f')} | {_f(record.get('oracle_m'), '.1f')} | "
+                     f"{_f(record.get('spl'))} | {link} |")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,164 @@
+"""The building generator: determinism, the format, the goals' spread, and that its worlds pass the check."""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import math
+import os
+import subprocess
+import sys
+
+import networkx as nx
+import numpy as np
+import pytest
+
+from abstract_map.clauses import Locational, Relational
+from abstract_map.grammar import Anchor, parse_cue
+from abstract_map.hierarchy import Hierarchy
+from abstract_map.prepositions import PREPOSITIONS
+from sim.world.check import check_world
+from sim.world.data import Floorplan, load_world
+from sim.world.generator import generate, generated_world, world_name, write_world
+from sim.world.oracle import OracleParams, free_cells
+from sim.world.styles import SIGNAGE, SIZES, STYLES
+
+STYLE_CASES = [(style, size, seed) for style in STYLES for size, seed in (("small", 1), ("medium", 1000))]
+
+
+@functools.cache
+def made(seed: int, style: str = "office", size: str = "small", signage: str = "complete"):
+    return generate(seed, style=style, size=size, signage=signage)
+
+
+@functools.cache
+def checked(seed: int, style: str = "office", size: str = "small", signage: str = "complete"):
+    g = made(seed, style, size, signage)
+    return check_world(g.world, hierarchy=g.hierarchy)
+
+
+def arrows_and_phrases(world):
+    for tag in world.tags.values():
+        if tag.kind == "sign":
+            for clause in parse_cue(tag.text, Anchor(f"#{tag.id}", tag.x, tag.y, tag.theta), kind="sign"):
+                yield tag, clause
+
+
+def test_same_seed_same_bytes_and_names_are_unique():
+    a = generate(5, style="hospital", size="small")
+    b = generate(5, style="hospital", size="small")
+    assert a.files == b.files
+    assert generate(6, style="hospital", size="small").files["floorplan.png"] != a.files["floorplan.png"]
+    names = {world_name(s, st, sz, sg) for s in (1, 2) for st in STYLES for sz in SIZES for sg in SIGNAGE}
+    assert len(names) == 2 * len(STYLES) * len(SIZES) * len(SIGNAGE)
+    assert b'"name": "gen-hospital-small-complete-5"' in a.files["world.json"]
+
+
+def test_same_bytes_in_another_process_with_another_hash_seed():
+    script = ("import hashlib, sys; from sim.world.generator import generate; "
+              "g = generate(7, style='campus', size='small', signage='misleading'); "
+              "sys.stdout.write(hashlib.sha256(b''.join(g.files[k] for k in sorted(g.files))).hexdigest())")
+    digests = {subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True,
+                              env={**os.environ, "PYTHONHASHSEED": seed}).stdout for seed in ("1", "2")}
+    here = made(7, "campus", "small", "misleading")
+    assert digests == {hashlib.sha256(b"".join(here.files[k] for k in sorted(here.files))).hexdigest()}
+
+
+@pytest.mark.parametrize("style, size, seed", STYLE_CASES)
+def test_every_style_makes_a_world_that_passes_the_check(style, size, seed, tmp_path):
+    g = made(seed, style, size)
+    report = checked(seed, style, size)
+    assert report.ok, report.table()
+    assert report.checked["arrows"] >= 5 and report.checked["phrases"] >= 5
+    folder = write_world(g, tmp_path / g.name)
+    world = load_world(folder)
+    hierarchy = Hierarchy.from_xml(world.hierarchy_path)
+    assert set(world.goals) == set(g.goal_roles) and len(world.goals) == 5
+    assert set(world.oracle_m) == set(world.goals) and all(v > 0 for v in world.oracle_m.values())
+    assert all(0 <= t <= 586 for t in world.tags)
+    assert 2 <= max(hierarchy.levels().values()) <= 4
+    for tag in world.tags.values():  # every text parses; labels name places of the hierarchy
+        parse_cue(tag.text, Anchor(f"#{tag.id}", tag.x, tag.y, tag.theta), kind=tag.kind)
+        assert tag.kind != "label" or tag.text in hierarchy.places
+    for place in hierarchy.places:  # names the grammar keeps whole
+        assert "," not in place and " and " not in place and " is " not in place
+        assert not place.lower().startswith(("the ", "a ", "an "))
+    if size == "medium":
+        rooms = len(g.layout.rooms)
+        assert 40 <= g.layout.width <= 70 and 15 <= rooms <= 48 and 25 <= len(world.tags) <= 60
+
+
+def test_goals_are_spread_behind_a_loop_off_a_dead_end_and_named_by_no_arrow():
+    for style in STYLES:
+        g = made(1000, style, "medium")
+        roles = {role: goal for goal, role in g.goal_roles.items()}
+        assert {"loop", "dead end", "no arrow"} <= set(roles)
+        rooms = {r.name: r for r in g.layout.rooms}
+        graph = g.layout.graph
+        bridges = {tuple(sorted(e)) for e in nx.bridges(graph)}
+        assert tuple(sorted(rooms[roles["loop"]].edge)) not in bridges  # its corridor lies on a cycle
+        dead = rooms[roles["dead end"]].edge
+        outer = min(g.layout.entrance)
+        assert any(graph.degree(n) == 1 and n != outer for n in dead)
+        named = {c.toponym for _, c in arrows_and_phrases(g.world) if isinstance(c, Locational) and c.kind == "arrow"}
+        assert roles["no arrow"] not in named
+
+
+def test_every_preposition_row_is_written_and_true():
+    rows = set()
+    for style in STYLES:
+        g = made(1000, style, "medium")
+        for _, clause in arrows_and_phrases(g.world):
+            if isinstance(clause, Relational):
+                rows.add(next(r.words[0] for r in PREPOSITIONS if clause.preposition in r.words))
+        assert not [f for f in checked(1000, style, "medium").failures if f.kind in ("arrow", "phrase")]
+    assert rows == {r.words[0] for r in PREPOSITIONS}
+
+
+def test_signage_levels_share_the_building():
+    complete, sparse, misleading = (made(3, "office", "medium", s) for s in ("complete", "sparse", "misleading"))
+    assert complete.files["floorplan.png"] == sparse.files["floorplan.png"] == misleading.files["floorplan.png"]
+    n_signs = [sum(t.kind == "sign" for t in g.world.tags.values()) for g in (complete, sparse, misleading)]
+    assert n_signs[1] < n_signs[0] and n_signs[2] == n_signs[1]
+    assert misleading.misleading and not complete.misleading
+    report = checked(3, "office", "medium", "misleading")
+    declared = [f for f in report.findings if f.declared]
+    assert report.ok and {(int(f.subject.split()[1])) for f in declared} == {m["tag"] for m in misleading.misleading}
+
+
+def test_one_metre_doors_pass_the_oracles_inflation():
+    for cell in (0.05, 0.1):
+        occupied = np.ones((60, 60), dtype=bool)
+        occupied[10:50, 5:28] = occupied[10:50, 32:55] = False  # two rooms, 0.2 m wall between (at 0.05 m/px)
+        occupied[25:45, 28:32] = False  # a 1 m door (20 px) through it
+        plan = Floorplan(occupied, 0.05, (0.0, 0.0))
+        from sim.world.oracle import distance_field, pool_plan
+
+        grid = pool_plan(plan, cell)
+        free = free_cells(grid, OracleParams().robot_radius_m)
+        a, b = grid.world_to_pixel(np.array([[0.7, 1.5], [2.3, 1.5]]))
+        cumulative, _ = distance_field(free, [tuple(a)])
+        assert math.isfinite(cumulative[tuple(b)])
+
+
+def test_write_world_is_atomic_and_refuses_to_overwrite(tmp_path):
+    g = made(2)
+    folder = write_world(g, tmp_path / "w")
+    assert sorted(p.name for p in folder.iterdir()) == sorted(g.files)
+    assert write_world(g, folder) == folder  # the same generation: left as it is
+    with pytest.raises(FileExistsError):
+        write_world(made(1), folder)
+    (tmp_path / "empty").mkdir()
+    assert write_world(g, tmp_path / "empty").is_dir()
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary folder left behind
+    path = generated_world(2, style="office", size="small", root=tmp_path / "root")
+    assert path.name == "gen-office-small-complete-2" and (path / "world.json").read_bytes() == g.files["world.json"]
+    assert generated_world(2, style="office", size="small", root=tmp_path / "root") == path
+
+
+def test_bad_arguments_are_value_errors():
+    for kwargs in ({"style": "castle"}, {"size": "huge"}, {"signage": "none"}):
+        with pytest.raises(ValueError, match="known"):
+            generate(1, **kwargs)
+    with pytest.raises(ValueError, match="seed"):
+        generate(-1)
