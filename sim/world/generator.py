@@ -43,10 +43,10 @@ from sim.world.layout import (
     build_layout,
 )
 from sim.world.oracle import oracle_paths
-from sim.world.signage import EXTRA_NAMES, SLACK, Sign, Writer, sign_spots
+from sim.world.signage import EXTRA_NAMES, Sign, Writer, sign_spots
 from sim.world.signage import _tag as _sign_tag
 from sim.world.styles import SIGNAGE, SIZES, STYLES, Size, Style, lookup
-from sim.world.truth import Facts, Routes, TruthParams, arrow_direction, hang, nearest_arrow, place_positions
+from sim.world.truth import Facts, Routes, TruthParams, arrow_direction, hang, place_positions
 
 FILES = ("world.json", "floorplan.png", "tags.json", "hierarchy.xml")
 N_TAG_IDS = 587  # AprilTag 36h11 has ids 0-586
@@ -68,6 +68,12 @@ class GeneratedWorld:
     layout: Layout
     goal_roles: dict[str, str]  # goal -> "loop" | "dead end" | "no arrow" | "hall" | "through room" | "far"
     misleading: list[dict[str, Any]]  # {"tag", "name", "arrow"}: arrows written wrong on purpose
+
+    def check(self):  # type: ignore[no-untyped-def]
+        """``check_world`` on the world in memory (its hierarchy is not on disk): a ``CheckReport``."""
+        from sim.world.check import check_world
+
+        return check_world(self.world, hierarchy=self.hierarchy)
 
 
 def world_name(seed: int, style: str, size: str, signage: str) -> str:
@@ -204,10 +210,6 @@ def _png(image: np.ndarray) -> bytes:
     return buffer.getvalue()
 
 
-def _hierarchy_object(nested: dict[str, Any]) -> Hierarchy:
-    return Hierarchy.from_nested(nested)
-
-
 def generate(seed: int, *, style: str = "office", size: str = "medium", signage: str = "complete") -> GeneratedWorld:
     """A building from ``seed`` (module docstring); pure: no files, same arguments, same bytes."""
     style_spec: Style = lookup(STYLES, style, "style")
@@ -219,7 +221,7 @@ def generate(seed: int, *, style: str = "office", size: str = "medium", signage:
     layout = build_layout(style_spec, size_spec, rng)
     goal_roles = _choose_goals(layout, rng)
     nested = _hierarchy(style_spec, size_spec, layout, rng)
-    hierarchy = _hierarchy_object(nested)
+    hierarchy = Hierarchy.from_nested(nested)
     image = layout.raster()
     plan = Floorplan(image < 128, RESOLUTION_M, (0.0, 0.0))
     params = TruthParams()
@@ -256,19 +258,26 @@ def generate(seed: int, *, style: str = "office", size: str = "medium", signage:
                          | {r.name for r in layout.rooms if r.name not in area_only})
     extras_pool = [n for n in extras_pool if n not in area_only and n not in hierarchy.roots()]
     signs: list[Sign] = []
-    for spot in entrance + junctions:
-        sign = Sign(spot)
+    for first in entrance + junctions:
+        wanted = list(dict.fromkeys(area_of[g] if g in area_only else g for g in goals
+                                    if first.node is None or _passes(oracle[g].path, layout, first.node)))
+        best: tuple[int, Sign] | None = None
+        for spot in [first, *first.alternates]:  # another wall of the junction when a goal cannot be pointed at
+            sign = Sign(spot)
+            for name in writer.arrows(sign, wanted):  # the goal itself when its area cannot be pointed at
+                goal = next((g for g in goals if area_of[g] == name and g not in area_only), None)
+                if goal is not None:
+                    writer.arrows(sign, [goal])
+            named = sum(1 for g in goals if (area_of[g] if g in area_only else g) in wanted
+                        and ({g, area_of[g]} & sign.names()))
+            if best is None or named > best[0]:
+                best = (named, sign)
+            if named == sum(1 for g in goals if (area_of[g] if g in area_only else g) in wanted):
+                break
+        assert best is not None
+        sign = best[1]
+        spot = sign.spot
         here = np.array([spot.x, spot.y])
-        wanted = []
-        for g in goals:
-            passes = spot.node is None or _passes(oracle[g].path, layout, spot.node)
-            if passes:
-                wanted.append(area_of[g] if g in area_only else g)
-        skipped = writer.arrows(sign, list(dict.fromkeys(wanted)))
-        for name in skipped:  # the goal itself when its area cannot be pointed at clearly, or vice versa
-            goal = next((g for g in goals if area_of[g] == name and g not in area_only), None)
-            if goal is not None:
-                writer.arrows(sign, [goal])
         pool = [n for n in extras_pool if n not in sign.names()]
         pool.sort(key=lambda n: float(np.hypot(*(facts.positions[n] - here))) if n in facts.positions else 1e9)
         pool = pool[:12]
@@ -419,5 +428,4 @@ def generated_world(seed: int, *, style: str = "office", size: str = "medium", s
     return write_world(generate(seed, style=style, size=size, signage=signage), folder)
 
 
-__all__ = ["GeneratedWorld", "generate", "write_world", "generated_world", "world_name", "SLACK",
-           "nearest_arrow"]
+__all__ = ["GeneratedWorld", "generate", "write_world", "generated_world", "world_name"]

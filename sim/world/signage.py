@@ -37,6 +37,7 @@ class SignSpot:
     y: float
     theta: float  # rad
     node: Node | None  # the junction it serves (None: the entrance)
+    alternates: list[SignSpot] = field(default_factory=list)  # other walls at the same junction, in preference order
 
 
 @dataclass
@@ -147,11 +148,15 @@ def _junction_spot(layout: Layout, node: Node, d: np.ndarray, fits) -> SignSpot 
             candidates += [(face + j * perp, theta) for j in (0.0, 0.7, -0.7, 1.4, -1.4, 2.1, -2.1)]
         if k == 0:  # corners only for the arrival direction
             candidates += [(face + p * (along_half + extra), theta) for p in (perp, -perp) for extra in (0.8, 1.4, 2.0)]
+    found: list[SignSpot] = []
     for c, theta in candidates:
         spot = SignSpot(round(float(c[0]), 4), round(float(c[1]), 4), theta, node)
-        if fits(spot):
-            return spot
-    return None
+        if len(found) < 3 and fits(spot) and all(math.dist((spot.x, spot.y), (f.x, f.y)) > 0.5 for f in found):
+            found.append(spot)
+    if not found:
+        return None
+    found[0].alternates = found[1:]
+    return found[0]
 
 
 @dataclass

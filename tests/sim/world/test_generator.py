@@ -17,7 +17,6 @@ from abstract_map.clauses import Locational, Relational
 from abstract_map.grammar import Anchor, parse_cue
 from abstract_map.hierarchy import Hierarchy
 from abstract_map.prepositions import PREPOSITIONS
-from sim.world.check import check_world
 from sim.world.data import Floorplan, load_world
 from sim.world.generator import generate, generated_world, world_name, write_world
 from sim.world.oracle import OracleParams, free_cells
@@ -33,8 +32,7 @@ def made(seed: int, style: str = "office", size: str = "small", signage: str = "
 
 @functools.cache
 def checked(seed: int, style: str = "office", size: str = "small", signage: str = "complete"):
-    g = made(seed, style, size, signage)
-    return check_world(g.world, hierarchy=g.hierarchy)
+    return made(seed, style, size, signage).check()
 
 
 def arrows_and_phrases(world):

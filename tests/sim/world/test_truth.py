@@ -92,3 +92,24 @@ def test_first_leg_is_the_first_straight_stretch():
     assert first_leg(jog, None, params) == pytest.approx(math.pi / 2, abs=0.1)
     here = np.array([[1.0, 1.0]])  # already readable: the leg points at the place
     assert first_leg(here, np.array([1.0, 3.0]), params) == pytest.approx(math.pi / 2)
+
+
+def test_past_and_before_say_the_same_thing_from_either_end():
+    hypothesis = pytest.importorskip("hypothesis")
+    st = hypothesis.strategies
+    point = st.tuples(st.floats(-50, 50), st.floats(-50, 50))
+
+    @hypothesis.given(point, point, point)
+    @hypothesis.settings(max_examples=200, deadline=None)
+    def check(c, r, f):
+        hypothesis.assume(len({c, r, f}) == 3)
+        both = facts(C=c, R=r, F=f)
+        # "F is past R" (from C) and "R is before F" (from C) are one statement
+        assert (phrase_verdict(both, "past", "F", ("R",), "C") is None) == \
+            (phrase_verdict(both, "before", "R", ("F",), "C") is None)
+        # mirrored in x, right becomes left
+        mirror = facts(C=(-c[0], c[1]), R=(-r[0], r[1]), F=(-f[0], f[1]))
+        assert (phrase_verdict(both, "right of", "F", ("R",), "C") is None) == \
+            (phrase_verdict(mirror, "left of", "F", ("R",), "C") is None)
+
+    check()
