@@ -14,8 +14,9 @@ trials   wall time and real-time factor of the Lion trial, per perception mode
 study    total wall time of a small study (1 trial per goal, geometric, 2 workers)
 generate time to generate a building per style and size, and how many pass the world check
 generalise  test buildings (seeds 1000-1049, styles and signage levels cycling), 5 goals each, geometric
-         perception, navigators paper and frontier; then 10 of them (1000-1009) with the camera and the paper
-         navigator. Success, SPL, ratio to oracle and wall time per navigator and signage level, and per style.
+         perception, navigators paper, frontier and viewpoint; then 10 of them (1000-1009) with the camera
+         and the paper and viewpoint navigators. Success, SPL, ratio to oracle and wall time per navigator and
+         signage level, and per style.
          A resumable study folder (--out, default runs/generalise); named only, never part of the default set.
 recording  what a rerun recording (--log) costs: the Kingfisher trial with and without it, per perception mode
            (needs the viz extra)
@@ -192,7 +193,8 @@ def bench_generalise(buildings: int = 50, camera_buildings: int = 10, workers: i
         generalise_tables(records, f"Generalisation, the {len(records)} trials finished so far in {out}")
         return
     began = time.perf_counter()
-    parts = [("geometric", buildings, ("paper", "frontier")), ("camera", camera_buildings, ("paper",))]
+    parts = [("geometric", buildings, ("paper", "frontier", "viewpoint")),
+             ("camera", camera_buildings, ("paper", "viewpoint"))]
     records: list[dict] = []
     for perception, count, navigators in parts:
         if count < 1:

@@ -134,6 +134,7 @@ def animation(result: TrialResult, world: World, path: str | os.PathLike[str], *
 def _draw_frame(ax: Axes, frame: Frame, result: TrialResult, world: World) -> None:
     extent = result.grid_extent or world.floorplan.extent
     ax.imshow(frame.grid, cmap="gray", extent=extent, origin="upper", alpha=0.6, interpolation="nearest")
+    _draw_layers(ax, frame.layers, extent)
     done = result.trajectory[result.trajectory[:, 0] <= frame.t_s]
     if len(done):
         ax.plot(done[:, 1], done[:, 2], color="tab:blue", lw=1.5)
@@ -144,3 +145,15 @@ def _draw_frame(ax: Axes, frame: Frame, result: TrialResult, world: World) -> No
     x, y, theta = frame.pose
     ax.plot(x, y, "o", color="tab:blue", ms=7)
     ax.arrow(x, y, 0.8 * np.cos(theta), 0.8 * np.sin(theta), width=0.08, color="tab:blue")
+
+
+LAYER_COLOURS = {"swept": (0.0, 0.6, 0.9), "belief": (0.9, 0.1, 0.5)}  # RGB of each policy layer
+
+
+def _draw_layers(ax: Axes, layers: dict[str, np.ndarray], extent: tuple[float, float, float, float]) -> None:
+    """A policy's layers (uint8 images on the grid) as tints: swept space blue, the goal belief magenta."""
+    for name, image in layers.items():
+        rgba = np.zeros((*image.shape, 4))
+        rgba[..., :3] = LAYER_COLOURS.get(name, (0.5, 0.5, 0.0))
+        rgba[..., 3] = (image / 255.0) ** 0.5 * 0.8  # square root: the belief's tail stays visible
+        ax.imshow(rgba, extent=extent, origin="upper", interpolation="nearest", zorder=2)

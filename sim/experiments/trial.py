@@ -19,12 +19,14 @@ from typing import Any
 import numpy as np
 
 from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
+from sim.navigation.belief import BeliefParams
 from sim.navigation.follower import FollowerParams
 from sim.navigation.navigator import CueEvent, NavigatorParams
 from sim.navigation.planner import PlannerParams
 from sim.navigation.policies import PolicyParams, make_policy
 from sim.navigation.replanner import ReplanParams
 from sim.navigation.targeting import TargetParams
+from sim.navigation.viewpoints import ViewpointParams
 from sim.perception import PERCEPTION_MODES, GeometricParams, Sighting, make_perception
 from sim.perception.laser import LaserParams, laser_angles, scan
 from sim.world.data import World, load_world
@@ -55,6 +57,8 @@ class TrialParams:
     follower: FollowerParams = field(default_factory=FollowerParams)
     targeting: TargetParams = field(default_factory=TargetParams)
     target_recheck_s: float = 5.0  # s between re-choosing the target when the model has not changed
+    belief: BeliefParams = field(default_factory=BeliefParams)  # the viewpoint navigator's goal belief and sweep
+    viewpoints: ViewpointParams = field(default_factory=ViewpointParams)  # ... and how it values viewpoints
     laser: LaserParams = field(default_factory=LaserParams)
     occupancy_resolution_m: float = 0.1  # m, grid cell
 
@@ -69,6 +73,7 @@ class Frame:
     places: dict[str, tuple[float, float]]
     target: tuple[float, float]
     path: np.ndarray | None
+    layers: dict[str, np.ndarray] = field(default_factory=dict)  # uint8 (0-255) images on the grid, e.g. belief
 
 
 @dataclass
@@ -134,7 +139,7 @@ def occupancy_grid(world: World, params: TrialParams) -> OccupancyGrid:
 def policy_params(params: TrialParams) -> PolicyParams:
     """The slice of the trial's parameters a navigation policy is built from."""
     return PolicyParams(params.navigator, params.planner, params.replan, params.follower, params.targeting,
-                        params.target_recheck_s)
+                        params.target_recheck_s, params.belief, params.viewpoints)
 
 
 Observer = Callable[["Trial"], None]
@@ -269,7 +274,9 @@ class Trial:
     def snapshot(self, pose: tuple[float, float, float]) -> Frame:
         """An animation frame of the trial now."""
         places, target, path = self.policy.picture()
-        return Frame(self.t, pose, self.grid.to_image(), places, target, path)
+        layers = getattr(self.policy, "layers", dict)()
+        images = {name: np.round(255 * np.clip(image, 0.0, 1.0)).astype(np.uint8) for name, image in layers.items()}
+        return Frame(self.t, pose, self.grid.to_image(), places, target, path, images)
 
     def result(self) -> TrialResult:
         """What the trial did so far, as written to result.json."""

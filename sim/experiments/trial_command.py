@@ -4,6 +4,7 @@ Example:
   abstract-map trial --world zoo --goal Lion --out runs/lion
   abstract-map trial --world zoo --goal Toilets --perception geometric --seed 3 --out runs/t3 --record
   abstract-map trial --world zoo --goal Lion --navigator frontier --perception geometric --out runs/f
+  abstract-map trial --world zoo --goal Lion --navigator viewpoint --out runs/lion-viewpoint --record
   abstract-map trial --world zoo --goal Kingfisher --out runs/k --log runs/k/run.rrd   (then: rerun runs/k/run.rrd)
 
 Prints a live progress line (simulated time, distance, cues read), then writes
@@ -11,7 +12,8 @@ DIR/result.json (goal, success, reason, distance_m, simulated and wall seconds,
 cues read in order with the distance at each, the trajectory) and
 DIR/trajectory.png (floor plan, path, tags read, final imagined places).
 --record also writes DIR/run.gif, an animation of the robot, the explored map
-and the abstract map. --log FILE.rrd writes a rerun recording on the
+and the abstract map (with --navigator viewpoint also the goal belief, magenta,
+and the swept space, blue). --log FILE.rrd writes a rerun recording on the
 simulated-time line (needs the [viz] extra). Exit code 0 when the goal was found, 1 when the trial
 failed (the reason is in result.json), 2 on bad input.
 """
@@ -37,8 +39,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--perception", default="camera", choices=["camera", "geometric"],
                         help="rendered camera + OpenCV AprilTag detector, or the fast geometric check")
     parser.add_argument("--navigator", default="paper",
-                        help="navigation policy: paper (the paper's robot, reads signs; default) or frontier "
-                             "(nearest frontier, reads no sign: the no-signs lower bound)")
+                        help="navigation policy: paper (the paper's robot, reads signs; default), frontier "
+                             "(nearest frontier, reads no sign: the no-signs lower bound) or viewpoint (negative "
+                             "information: to where the goal's label may still be read)")
     parser.add_argument("--out", type=Path, required=True, help="output folder")
     parser.add_argument("--record", action="store_true", help="also write DIR/run.gif, an animation of the run")
     parser.add_argument("--log", type=Path, metavar="FILE.rrd",

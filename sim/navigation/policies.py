@@ -11,25 +11,33 @@ differs is where it wants to go. Register a new one in :data:`NAVIGATORS`.
 - ``frontier``: the no-signs lower bound: reads no sign, drives to the nearest
   reachable frontier (by path length) until the goal's label comes into view,
   and gives up when no frontier is left.
+- ``viewpoint``: negative information and readable viewpoints: a belief over
+  where the goal's label hangs (the abstract map's imagined goal as its prior,
+  ruled out where the camera has swept), driven to the reachable viewpoint that
+  reads the most of it per metre; the model grows when the belief near the
+  imagined goal is used up, and unswept wall near the robot draws it when the
+  cues say little (see ``docs/method-notes.md``).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
 
 from abstract_map.model import imagined_positions
 from sim.mapping.occupancy import OccupancyGrid
+from sim.navigation.belief import Belief, BeliefParams, SweptSpace, cue_mass, goal_belief, goal_sigma
 from sim.navigation.follower import FollowerParams, PathFollower, Recovery, RecoveryParams, StuckDetector, StuckParams
 from sim.navigation.frontier import FrontierParams, look, nearest_frontier, still_frontier
 from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
 from sim.navigation.planner import Plan, PlannerParams
 from sim.navigation.replanner import Replanner, ReplanParams
 from sim.navigation.targeting import Target, TargetParams, choose_target
+from sim.navigation.viewpoints import ViewpointParams, Viewpoints, score_viewpoints, travel_costs
 from sim.perception.sighting import Sighting
 from sim.world.data import World
 
@@ -46,6 +54,8 @@ class PolicyParams:
     follower: FollowerParams
     targeting: TargetParams
     target_recheck_s: float  # s between re-choosing the target when nothing new was read
+    belief: BeliefParams = field(default_factory=BeliefParams)
+    viewpoints: ViewpointParams = field(default_factory=ViewpointParams)
 
 
 class Policy(Protocol):
@@ -215,9 +225,109 @@ class FrontierPolicy:
         return []
 
 
+class ViewpointPolicy:
+    """Negative information: to where the goal's label may still be read, growing the model when it is used up."""
+
+    def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
+        self.params = params
+        self.nav = Navigator.start(world, goal, start, params=params.navigator)
+        self.drive = DriveStack(params)
+        self.swept: SweptSpace | None = None
+        self.belief: Belief | None = None
+        self.views: Viewpoints | None = None
+        self.target: np.ndarray | None = None
+        self.target_at = -float("inf")
+        self.swept_at = -float("inf")
+        self.visited: list[np.ndarray] = []
+        self.bumps = 0  # exploration bumps in all
+        self.gave_up = ""
+
+    @property
+    def cues(self) -> list[CueEvent]:
+        return self.nav.cues
+
+    def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
+                grid: OccupancyGrid) -> None:
+        if self.nav.observe(sightings, t_s=t_s, distance_m=distance_m, explored_centre=grid.explored_centre):
+            self.target = None
+
+    def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
+                rng: np.random.Generator) -> tuple[float, float]:
+        vp = self.params.viewpoints
+        if self.swept is None:
+            self.swept = SweptSpace(grid, self.params.belief)
+        if t_s - self.swept_at >= vp.sweep_every_s:
+            self.swept.sweep(grid, pose[:2])
+            self.swept_at = t_s
+        if self.target is None or t_s - self.target_at >= vp.retarget_s:
+            self._retarget(t_s, np.array(pose[:2]), grid)
+            if self.gave_up:
+                return 0.0, 0.0
+        assert self.target is not None
+        v, w, arrived = self.drive.drive(t_s, pose, grid, self.target, tick_s, self.nav.params.arrive_m, rng)
+        if arrived:
+            self.visited.append(self.target)
+            self.target = None
+        return v, w
+
+    def _goal_belief(self, grid: OccupancyGrid, robot_xy: np.ndarray) -> Belief:
+        assert self.swept is not None
+        goal = self.nav.model.goal_estimate()  # off the map too: the prior's near edge then lies on it
+        anchors = np.array([f.xy for f in self.nav.model.fixed.values()])
+        sigma = goal_sigma(goal, anchors, self.params.belief)
+        return goal_belief(grid, self.swept.swept, goal, sigma, self.params.belief)
+
+    def _retarget(self, t_s: float, robot_xy: np.ndarray, grid: OccupancyGrid) -> None:
+        """Choose the viewpoint reading the most belief per metre; grow the model while the belief is used up."""
+        vp, bp = self.params.viewpoints, self.params.belief
+        assert self.swept is not None
+        self.belief = self._goal_belief(grid, robot_xy)
+        # Negative information fed back into the abstract map: the label is not where the model imagines it
+        # (one growth step per re-valuing, so the model moves out gradually).
+        if self.belief.remaining < vp.exhausted_remaining and self.nav.arrived_without_goal(grid.explored_centre()):
+            self.bumps += 1
+            self.belief = self._goal_belief(grid, robot_xy)
+        mass = self.belief.mass + vp.cue_weight * cue_mass(grid, self.swept.swept, robot_xy, vp.cue_radius_m, bp)
+        travel = travel_costs(grid, robot_xy, self.params.planner, vp.escape_cost, pool=vp.travel_pool)
+        self.views = views = score_viewpoints(grid, travel, mass, vp, bp, self.visited)
+        self.target_at = t_s
+        best = views.best()
+        if best is None:
+            if self.target is None:
+                self.target = np.asarray(self.nav.target(robot_xy), dtype=float)
+            return
+        if self.target is not None:
+            here = np.hypot(*(views.xy - self.target).T)
+            current = int(np.argmin(here))
+            if here[current] < vp.block_m and views.score[current] >= vp.keep_ratio * views.score[best]:
+                return
+        self.target = views.xy[best].copy()
+        self.drive.replanner.request()
+
+    def picture(self) -> tuple[dict[str, tuple[float, float]], tuple[float, float], np.ndarray | None]:
+        shown = self.nav.target() if self.target is None else self.target
+        plan = self.drive.plan
+        return dict(imagined_positions(self.nav.model)), tuple(shown), None if plan is None else plan.waypoints
+
+    def layers(self) -> dict[str, np.ndarray]:
+        """For drawing, on the occupancy grid's cells: the goal belief (scaled to its peak) and the swept space."""
+        out: dict[str, np.ndarray] = {}
+        if self.belief is not None:
+            peak = float(self.belief.mass.max())
+            out["belief"] = self.belief.mass / peak if peak > 0 else self.belief.mass
+        if self.swept is not None:
+            out["swept"] = self.swept.swept
+        return out
+
+    def settle_ms(self) -> list[float]:
+        settles = self.nav.settles
+        return [s.wall_s * 1000 for s in settles[1:]] or [settles[0].wall_s * 1000]
+
+
 NAVIGATORS: dict[str, type] = {
     "paper": PaperPolicy,
     "frontier": FrontierPolicy,
+    "viewpoint": ViewpointPolicy,
 }
 """Every navigation policy by its ``--navigator`` name; each is built as ``cls(world, goal, start, params)``."""
 

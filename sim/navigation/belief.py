@@ -1,0 +1,257 @@
+"""Negative information: where the goal's label has been looked for, and where it may still be.
+
+Two grids over the robot's occupancy grid (same cells, world frame, metres):
+
+- :class:`SweptSpace`: for each cell, whether a label hung there (on a wall
+  the robot has mapped) would already have been read: within the reading range
+  of a camera position the robot passed, inside the reading cone about the
+  wall's normal, with a clear line of sight over the occupancy grid. This is
+  the perception's reading rule (see :mod:`sim.world.visibility`) asked of the
+  robot's own map, with margins so that "swept" means "would have been read".
+- :func:`goal_belief`: a distribution over the cell holding the goal's label.
+  Its prior is the abstract map's: a Gaussian about the goal's imagined
+  position, its spread growing with how far that position is extrapolated from
+  anything observed. Labels hang on walls, so a cell's prior is weighted by the
+  chance it is wall (1 mapped wall, 0 mapped free, ``unknown_wall_prob``
+  unseen); swept cells are multiplied by the chance a label there was missed.
+
+See ``docs/method-notes.md`` (negative information) for the equations.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from sim.mapping.occupancy import OccupancyGrid
+
+
+@dataclass(frozen=True)
+class BeliefParams:
+    """The reading rule the sweep assumes, and the goal belief's prior."""
+
+    read_range_m: float = 3.5  # m; the perception reads to 4 m, the sweep claims only this much (camera margin)
+    read_min_m: float = 1.0  # m; the camera misses tags closer than ~1 m below it, so nearer is not swept
+    cone_half_angle_deg: float = 40.0  # deg about the wall normal; the perception's 45 less a margin
+    los_skip_m: float = 0.09  # m; the last part of a sight line (inside the label's own wall cell) is not checked
+    detect_prob: float = 0.95  # chance a label in swept space would have been read (camera misses, odd walls)
+    normal_smoothing_m: float = 0.2  # m, std of the smoothing of the wall-orientation (structure) tensor
+    corner_coherence: float = 0.3  # below this wall-orientation coherence (corners, specks) any view angle counts
+    unknown_wall_prob: float = 0.05  # chance an unseen cell holds a label-bearing wall face, against a mapped face's 1
+    sigma_min_m: float = 2.0  # m, spread of the goal's prior with evidence right beside it
+    sigma_per_m: float = 0.35  # m of spread per m between the imagined goal and the nearest observed anchor
+    label_offset_m: float = 2.0  # m, a place's label hangs about this far from the place (level-1 label length)
+    tail_weight: float = 0.15  # share of the prior in a wide tail: the model may be wrong (a sign misread, a guess)
+    tail_scale: float = 3.0  # the tail's spread, in multiples of sigma
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """One look: the cells newly swept from a camera position."""
+
+    camera_xy: tuple[float, float]  # m
+    cells: np.ndarray  # (N, 2) row, col
+
+
+def cell_window(rc: np.ndarray, reach: int, shape: tuple[int, int]) -> tuple[int, int, int, int]:
+    """Row and column bounds (r0, r1, c0, c1) of the cells within ``reach`` cells of ``rc``, clipped to ``shape``."""
+    rows, cols = shape
+    return (max(0, int(rc[0]) - reach), min(rows, int(rc[0]) + reach + 1),
+            max(0, int(rc[1]) - reach), min(cols, int(rc[1]) + reach + 1))
+
+
+def wall_axes(occupied: np.ndarray, smoothing_cells: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per cell, the unsigned wall-normal angle (rad) and its coherence in [0, 1] from the structure tensor.
+
+    The structure tensor of the occupied mask (gradient outer products, smoothed)
+    has its dominant eigenvector across the wall; coherence (l1 - l2) / (l1 + l2)
+    is ~1 along straight walls and ~0 at corners and isolated specks.
+    """
+    occ = occupied.astype(np.float32)
+    gy = ndimage.sobel(occ, axis=0)  # rows grow downwards (towards -y)
+    gx = ndimage.sobel(occ, axis=1)
+    gy = -gy
+    s = max(smoothing_cells, 0.5)
+    jxx = ndimage.gaussian_filter(gx * gx, s)
+    jyy = ndimage.gaussian_filter(gy * gy, s)
+    jxy = ndimage.gaussian_filter(gx * gy, s)
+    angle = 0.5 * np.arctan2(2.0 * jxy, jxx - jyy)
+    trace = jxx + jyy
+    coherence = np.sqrt((jxx - jyy) ** 2 + 4.0 * jxy ** 2) / np.maximum(trace, 1e-9)
+    coherence[trace < 1e-6] = 0.0
+    return angle, coherence
+
+
+def sight_clear(occupied: np.ndarray, grid: OccupancyGrid, origin_xy: np.ndarray, ends_xy: np.ndarray,
+                skip_m: float, step_cells: float = 0.5) -> np.ndarray:
+    """For each end (N, 2 m), whether the segment from ``origin_xy`` (one point, or one per end) to it, less
+    its last ``skip_m``, misses every cell set in ``occupied`` (sampled every ``step_cells`` cells; cells off
+    the grid count as clear)."""
+    ends = np.atleast_2d(np.asarray(ends_xy, dtype=float))
+    if len(ends) == 0:
+        return np.zeros(0, dtype=bool)
+    origins = np.broadcast_to(np.asarray(origin_xy, dtype=float), ends.shape)
+    res = grid.resolution
+    x0, y0 = grid.origin
+    rows, cols = occupied.shape
+    # Continuous cell coordinates: col = floor(u), row = rows - 1 - floor(v).
+    u0, v0 = (origins[:, 0] - x0) / res, (origins[:, 1] - y0) / res
+    du, dv = (ends[:, 0] - x0) / res - u0, (ends[:, 1] - y0) / res - v0
+    length = np.hypot(du, dv)
+    n = max(2, int(math.ceil(float(length.max()) / step_cells)) + 1)
+    s = np.linspace(0.0, 1.0, n, dtype=np.float32)[None, :]
+    use = s <= (np.maximum(length - skip_m / res, 0.0) / np.maximum(length, 1e-9))[:, None]
+    col = np.clip(np.floor(u0[:, None] + s * du[:, None]).astype(np.intp), 0, cols - 1)
+    row = np.clip(rows - 1 - np.floor(v0[:, None] + s * dv[:, None]).astype(np.intp), 0, rows - 1)
+    return ~np.any(occupied[row, col] & use, axis=1)
+
+
+def face_normals(occupied: np.ndarray, smoothing_cells: float
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per cell: the face normal (nx, ny) along the wall's axis towards its open side, whether the cell is a
+    one-sided face (1.0: open on one side of the axis only, 0.0: both or neither), and from
+    :func:`wall_axes` the unsigned axis angle (rad) and its coherence."""
+    axis, coherence = wall_axes(occupied, smoothing_cells)
+    ux, uy = np.cos(axis), np.sin(axis)
+    rows, cols = occupied.shape
+    rr, cc = np.mgrid[0:rows, 0:cols]
+    dr, dc = -np.rint(uy).astype(np.intp), np.rint(ux).astype(np.intp)
+    ahead = ~occupied[np.clip(rr + dr, 0, rows - 1), np.clip(cc + dc, 0, cols - 1)]
+    behind = ~occupied[np.clip(rr - dr, 0, rows - 1), np.clip(cc - dc, 0, cols - 1)]
+    sign = np.where(ahead & ~behind, 1.0, np.where(behind & ~ahead, -1.0, 0.0))
+    return sign * ux, sign * uy, np.abs(sign), axis, coherence
+
+
+def in_cone(site_xy: np.ndarray, camera_xy: np.ndarray, axis: np.ndarray, coherence: np.ndarray,
+            params: BeliefParams, normal: np.ndarray | None = None, sided: np.ndarray | None = None) -> np.ndarray:
+    """Whether each camera-site pair lies inside the reading cone about the site's wall normal.
+
+    Where the wall has one mapped face (``sided`` >= 0.5) the camera must be in
+    front of it (``normal``, (..., 2), points to the free side); otherwise
+    either side of the unsigned ``axis`` counts; at corners (low coherence) any.
+    """
+    d = np.asarray(camera_xy, dtype=float) - np.asarray(site_xy, dtype=float)
+    distance = np.maximum(np.hypot(d[..., 0], d[..., 1]), 1e-9)
+    cos_min = math.cos(math.radians(params.cone_half_angle_deg))
+    unsigned = np.abs(d[..., 0] * np.cos(axis) + d[..., 1] * np.sin(axis)) / distance
+    ok = (unsigned >= cos_min) | (coherence < params.corner_coherence)
+    if normal is not None and sided is not None:
+        signed = (d[..., 0] * normal[..., 0] + d[..., 1] * normal[..., 1]) / distance
+        ok = np.where(sided >= 0.5, signed >= cos_min, ok)
+    return ok
+
+
+class SweptSpace:
+    """Cells of the occupancy grid where a label would already have been read (1.0) or not (0.0)."""
+
+    def __init__(self, grid: OccupancyGrid, params: BeliefParams = BeliefParams()) -> None:
+        self.params = params
+        self.swept = np.zeros(grid.shape, dtype=bool)
+        self.looks = 0
+
+    def sweep(self, grid: OccupancyGrid, camera_xy: tuple[float, float] | np.ndarray) -> Sweep:
+        """Mark the mapped wall cells a label on which would be read from ``camera_xy`` (m) now."""
+        prm = self.params
+        camera = np.asarray(camera_xy, dtype=float)
+        res = grid.resolution
+        occupied = grid.occupied_mask()
+        rc = grid.world_to_cell(camera)[0]
+        reach = int(math.ceil(prm.read_range_m / res)) + 2
+        rows, cols = grid.shape
+        r0, r1, c0, c1 = cell_window(rc, reach, grid.shape)
+        self.looks += 1
+        window = occupied[r0:r1, c0:c1] & ~self.swept[r0:r1, c0:c1]
+        cand = np.argwhere(window) + np.array([r0, c0])
+        if len(cand) == 0:
+            return Sweep((float(camera[0]), float(camera[1])), np.zeros((0, 2), dtype=int))
+        xy = grid.cell_to_world(cand)
+        distance = np.hypot(*(xy - camera).T)
+        near = (distance <= prm.read_range_m) & (distance >= prm.read_min_m)
+        cand, xy = cand[near], xy[near]
+        # Wall orientation from a margin around the window, so walls at its edge are judged whole.
+        m = int(math.ceil(3 * prm.normal_smoothing_m / res)) + 1
+        q0, q1, p0, p1 = max(0, r0 - m), min(rows, r1 + m), max(0, c0 - m), min(cols, c1 + m)
+        nx, ny, sided, axis, coherence = face_normals(occupied[q0:q1, p0:p1], prm.normal_smoothing_m / res)
+        i, j = (cand - np.array([q0, p0])).T
+        ok = in_cone(xy, camera, axis[i, j], coherence[i, j], prm, np.stack([nx[i, j], ny[i, j]], axis=-1),
+                     sided[i, j])
+        cand, xy = cand[ok], xy[ok]
+        clear = sight_clear(occupied, grid, camera, xy, prm.los_skip_m)
+        cells = cand[clear]
+        self.swept[cells[:, 0], cells[:, 1]] = True
+        return Sweep((float(camera[0]), float(camera[1])), cells)
+
+
+@dataclass(frozen=True)
+class Belief:
+    """Where the goal's label may be: a distribution over the occupancy grid's cells."""
+
+    mass: np.ndarray  # (rows, cols) float, sums to 1 (all zero when nothing remains)
+    remaining: float  # the prior's probability of a label on the grid not yet ruled out, in [0, 1]
+    centre: tuple[float, float]  # m, the prior's mean (the goal's imagined position)
+    sigma_m: float  # m, the prior's spread
+
+
+def goal_sigma(goal_xy: np.ndarray, anchors_xy: np.ndarray, params: BeliefParams) -> float:
+    """Spread (m) of the goal's prior: the label offset, plus a share of the distance to the nearest observed
+    anchor (a tag read, or the start), in quadrature with the minimum."""
+    anchors = np.atleast_2d(np.asarray(anchors_xy, dtype=float))
+    nearest = float(np.min(np.hypot(*(anchors - goal_xy).T))) if anchors.size else 0.0
+    spread = max(params.sigma_min_m, params.sigma_per_m * nearest)
+    return math.hypot(spread, params.label_offset_m)
+
+
+def goal_belief(grid: OccupancyGrid, swept: np.ndarray, goal_xy: np.ndarray, sigma_m: float,
+                params: BeliefParams) -> Belief:
+    """Posterior over the label's cell: prior x wall chance x (1 - detect_prob on swept cells).
+
+    The prior is a Gaussian of spread ``sigma_m`` about ``goal_xy`` mixed with a
+    wide tail (``tail_weight``, ``tail_scale`` times the spread).
+
+    ``remaining`` is the posterior's normaliser against the prior's (both with
+    each cell's wall chance): the share of the prior on wall not yet swept, near
+    1 when nothing near the goal has been looked at, near 0 when it all has.
+    """
+    centre = np.asarray(goal_xy, dtype=float)
+    rows, cols = grid.shape
+    xy_col = grid.cell_to_world(np.stack([np.zeros(cols), np.arange(cols)], axis=1))[:, 0]
+    xy_row = grid.cell_to_world(np.stack([np.arange(rows), np.zeros(rows)], axis=1))[:, 1]
+    prior = np.zeros((rows, cols))
+    for weight, spread in ((1.0 - params.tail_weight, sigma_m), (params.tail_weight, params.tail_scale * sigma_m)):
+        gx = np.exp(-0.5 * ((xy_col - centre[0]) / spread) ** 2)
+        gy = np.exp(-0.5 * ((xy_row - centre[1]) / spread) ** 2)
+        prior += weight / spread ** 2 * np.outer(gy, gx)
+    wall = np.where(grid.occupied_mask(), 1.0, np.where(grid.free_mask(), 0.0, params.unknown_wall_prob))
+    weighted = prior * wall
+    posterior = weighted * np.where(swept, 1.0 - params.detect_prob, 1.0)
+    reference = float(weighted.sum())
+    total = float(posterior.sum())
+    mass = posterior / total if total > 0 else posterior
+    remaining = min(1.0, total / reference) if reference > 0 else 0.0
+    return Belief(mass.astype(np.float32), remaining, (float(centre[0]), float(centre[1])),
+                  float(sigma_m))
+
+
+def cue_mass(grid: OccupancyGrid, swept: np.ndarray, robot_xy: np.ndarray, radius_m: float,
+             params: BeliefParams) -> np.ndarray:
+    """Unswept wall (by wall chance) within ``radius_m`` (m) of the robot, summing to 1 (all zero if none):
+    where any cue, a sign or a label, may still be read."""
+    rows, cols = grid.shape
+    rc = grid.world_to_cell(np.asarray(robot_xy, dtype=float))[0]
+    reach = int(math.ceil(radius_m / grid.resolution))
+    out = np.zeros(grid.shape, dtype=np.float64)
+    r0, r1, c0, c1 = cell_window(rc, reach, grid.shape)
+    if r0 >= r1 or c0 >= c1:
+        return out
+    rr, cc = np.mgrid[r0:r1, c0:c1]
+    near = np.hypot(rr - rc[0], cc - rc[1]) <= reach
+    occ, free = grid.occupied_mask()[r0:r1, c0:c1], grid.free_mask()[r0:r1, c0:c1]
+    wall = np.where(occ, 1.0, np.where(free, 0.0, params.unknown_wall_prob))
+    window = near * wall * np.where(swept[r0:r1, c0:c1], 1.0 - params.detect_prob, 1.0)
+    total = window.sum()
+    if total > 0:
+        out[r0:r1, c0:c1] = window / total
+    return out

@@ -1,0 +1,78 @@
+"""Negative information: swept space and the goal belief."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
+from sim.navigation.belief import BeliefParams, SweptSpace, cue_mass, goal_belief, goal_sigma, sight_clear
+
+WALL_X = 6.0  # m, a mapped wall's west face
+
+
+def corridor() -> OccupancyGrid:
+    """10 m x 8 m: mapped free for x < 6 m, a mapped wall at x = 6.0 .. 6.2 m, unseen beyond."""
+    grid = OccupancyGrid(OccupancyParams(resolution_m=0.1, bounds=(0.0, 10.0, 0.0, 8.0)))
+    xy = grid.cell_to_world(np.argwhere(np.ones(grid.shape, dtype=bool)))
+    cells = grid.world_to_cell(xy)
+    free, wall = xy[:, 0] < WALL_X, (xy[:, 0] >= WALL_X) & (xy[:, 0] < WALL_X + 0.2)
+    grid.log_odds[cells[free, 0], cells[free, 1]] = -2.0
+    grid.log_odds[cells[wall, 0], cells[wall, 1]] = 3.0
+    return grid
+
+
+def wall_cells_at(grid: OccupancyGrid, y: float) -> tuple[int, int]:
+    return tuple(grid.world_to_cell(np.array([WALL_X + 0.05, y]))[0])
+
+
+def test_a_look_sweeps_the_wall_face_in_range_and_cone_only():
+    grid = corridor()
+    space = SweptSpace(grid, BeliefParams())
+    space.sweep(grid, (WALL_X - 2.5, 4.0))
+    assert space.swept[wall_cells_at(grid, 4.0)]  # straight ahead, 2.5 m
+    assert space.swept[wall_cells_at(grid, 5.5)]  # 31 deg off the normal
+    assert not space.swept[wall_cells_at(grid, 7.0)]  # 50 deg off: outside the reading cone
+    assert not space.swept[tuple(grid.world_to_cell(np.array([WALL_X + 0.15, 4.0]))[0])]  # the far face
+    far = SweptSpace(grid, BeliefParams())
+    far.sweep(grid, (1.0, 4.0))  # 5 m away: out of range
+    assert not far.swept.any()
+
+
+def test_walls_block_the_sight_line():
+    grid = corridor()
+    occupied = grid.occupied_mask()
+    clear = sight_clear(occupied, grid, np.array([2.0, 4.0]), np.array([[5.0, 4.0], [8.0, 4.0]]), 0.09)
+    assert clear.tolist() == [True, False]
+
+
+def test_swept_cells_lose_their_belief_and_the_rest_renormalises():
+    grid, params = corridor(), BeliefParams()
+    swept = np.zeros(grid.shape, dtype=bool)
+    before = goal_belief(grid, swept, np.array([7.0, 4.0]), 2.0, params)
+    assert before.mass.sum() == pytest.approx(1.0, rel=1e-5)
+    assert before.mass[grid.free_mask()].sum() == 0.0  # labels hang on walls, never in mapped free space
+    space = SweptSpace(grid, params)
+    space.sweep(grid, (WALL_X - 2.0, 4.0))
+    after = goal_belief(grid, space.swept, np.array([7.0, 4.0]), 2.0, params)
+    assert after.mass.sum() == pytest.approx(1.0, rel=1e-5)
+    ratio = after.mass[space.swept].sum() / before.mass[space.swept].sum()
+    rest = after.mass[~space.swept].sum() / before.mass[~space.swept].sum()
+    assert ratio < 0.5 < 1.0 < rest  # mass left the swept wall for the unswept cells
+    assert after.remaining < before.remaining
+
+
+def test_goal_spread_grows_with_distance_from_evidence():
+    params = BeliefParams()
+    near = goal_sigma(np.array([1.0, 0.0]), np.array([[0.0, 0.0]]), params)
+    far = goal_sigma(np.array([30.0, 0.0]), np.array([[0.0, 0.0]]), params)
+    assert near < far
+
+
+def test_cue_mass_is_unswept_wall_near_the_robot():
+    grid, params = corridor(), BeliefParams()
+    mass = cue_mass(grid, np.zeros(grid.shape, dtype=bool), np.array([3.0, 4.0]), 4.0, params)
+    assert mass.sum() == pytest.approx(1.0)
+    assert mass[grid.free_mask()].sum() == 0.0
+    far = grid.world_to_cell(np.array([[9.5, 0.5]]))[0]
+    assert mass[far[0], far[1]] == 0.0
