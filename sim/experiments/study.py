@@ -19,9 +19,7 @@ import csv
 import hashlib
 import io
 import json
-import os
 import re
-import tempfile
 import time
 import traceback
 from collections.abc import Callable, Iterable, Iterator
@@ -29,6 +27,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from abstract_map.files import write_text_atomic
 from sim.experiments.metrics import oracle_ratio, spl
 from sim.experiments.trial import TrialParams
 from sim.world.data import World
@@ -230,16 +229,9 @@ def check_settings(out: Path, settings: StudySettings, *, record: bool = True) -
 
 
 def write_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` by a temporary file beside it and a rename: never half-written."""
+    """Write ``text`` to ``path`` by a temporary file and a rename (creating its folder): never half-written."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    handle, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(handle, "w") as stream:
-            stream.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_text_atomic(path, text)
 
 
 def _load_record(path: Path, spec: TrialSpec) -> dict[str, Any] | None:

@@ -46,6 +46,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "(negative information); repeatable or a comma list, to compare them side by side")
     parser.add_argument("--workers", type=int, default=2, help="parallel trials (default 2)")
     parser.add_argument("--perception", default="camera", choices=["camera", "geometric"])
+    parser.add_argument("--log", action="store_true",
+                        help="also write a rerun recording of each trial, DIR/trials/WORLD/KEY.rrd (needs [viz])")
     parser.add_argument("--goals", nargs="+", help="only these goals (default: every goal of every world)")
     parser.add_argument("--executor", default="process", choices=["process", "ray"],
                         help="local process pool (default) or Ray (needs the [ray] extra)")
@@ -69,6 +71,13 @@ def run(args: argparse.Namespace) -> int:
         raise ExitError("--trials and --workers must be at least 1")
     if args.goals and len(set(args.goals)) != len(args.goals):
         raise ExitError(f"--goals {args.goals}: a goal is named twice")
+    if args.log:
+        from sim.experiments.recording import MissingExtraError, rerun_module
+
+        try:
+            rerun_module()
+        except MissingExtraError as exc:
+            raise ExitError(str(exc)) from exc
     settings = StudySettings(worlds=tuple(args.world or ["zoo"]), perception=args.perception,
                              navigators=navigator_list(args.navigator), trials=args.trials,
                              goals=tuple(args.goals) if args.goals else None)
@@ -87,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         outcome = conduct_study(settings, args.out, workers=args.workers, executor=args.executor,
-                                address=args.address, progress=progress)
+                                address=args.address, progress=progress, log=args.log)
     except ValueError as exc:  # StudyError, WorldSpecError, WorldError: bad input, one line
         raise ExitError(str(exc)) from exc
     finally:

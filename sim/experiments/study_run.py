@@ -16,7 +16,7 @@ import sys
 import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
@@ -145,7 +145,7 @@ def write_outputs(out: Path, records: list[dict[str, Any]], worlds: list[World],
 
 
 def conduct_study(settings: StudySettings, out: Path, *, workers: int = 2, executor: str = "process",
-                  address: str | None = None, progress: Progress | None = None) -> StudyOutcome:
+                  address: str | None = None, progress: Progress | None = None, log: bool = False) -> StudyOutcome:
     """Run (or resume) the study ``settings`` in ``out`` and write its report.
 
     Raises :class:`sim.experiments.study.StudyError` when ``out`` holds another study, and ValueError
@@ -162,6 +162,8 @@ def conduct_study(settings: StudySettings, out: Path, *, workers: int = 2, execu
     began = time.perf_counter()
     worlds = build_worlds(settings, out, workers=workers)
     specs = plan_study(worlds, settings)
+    if log:  # a rerun recording of each trial beside its record: trials/WORLD/KEY.rrd
+        specs = [replace(spec, log_dir=str(out / "trials")) for spec in specs]
     check_settings(out, settings)  # recorded only once the settings proved good
     records = run_study(specs, out, executor=make_executor(executor, workers, address), progress=progress)
     wall = time.perf_counter() - began

@@ -75,3 +75,14 @@ def test_a_study_trial_writes_its_recording(tiny_world, tmp_path):
     assert run_spec(spec)["success"]
     assert [p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*.rrd")] == [f"{spec.key}.rrd"]
     assert "world/robot" in entities(tmp_path / f"{spec.key}.rrd")
+
+
+def test_study_log_writes_a_recording_per_trial(tiny_world, tmp_path):
+    pytest.importorskip("rerun")
+    from abstract_map.cli import main
+
+    out = tmp_path / "study"
+    assert main(["study", "--world", str(tiny_world.root), "--trials", "1", "--perception", "geometric",
+                 "--workers", "1", "--log", "--out", str(out)]) == 0
+    recordings = list((out / "trials").rglob("*.rrd"))
+    assert len(recordings) == 1 and "world/robot" in entities(recordings[0])
