@@ -111,14 +111,16 @@ class DriveStack:
         return v, w, arrived
 
 
-class PaperPolicy:
-    """The paper's robot: to the goal's imagined position, growing the model when it is not there."""
+class AbstractMapPolicy:
+    """What every policy that keeps an abstract map shares: the model, its drive stack, cues and settle times."""
+
+    target: object | None  # the current target, forgotten when the model changes
 
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
         self.params = params
         self.nav = Navigator.start(world, goal, start, params=params.navigator)
         self.drive = DriveStack(params)
-        self.target: Target | None = None
+        self.target = None
         self.target_at = -float("inf")
         self.bumps = 0  # exploration bumps in all
         self.gave_up = ""
@@ -131,6 +133,16 @@ class PaperPolicy:
                 grid: OccupancyGrid) -> None:
         if self.nav.observe(sightings, t_s=t_s, distance_m=distance_m, explored_centre=grid.explored_centre):
             self.target = None
+
+    def settle_ms(self) -> list[float]:
+        settles = self.nav.settles
+        return [s.wall_s * 1000 for s in settles[1:]] or [settles[0].wall_s * 1000]
+
+
+class PaperPolicy(AbstractMapPolicy):
+    """The paper's robot: to the goal's imagined position, growing the model when it is not there."""
+
+    target: Target | None
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:
@@ -156,10 +168,6 @@ class PaperPolicy:
         shown = self.nav.target() if self.target is None else self.target.xy
         plan = self.drive.plan
         return dict(imagined_positions(self.nav.model)), tuple(shown), None if plan is None else plan.waypoints
-
-    def settle_ms(self) -> list[float]:
-        settles = self.nav.settles
-        return [s.wall_s * 1000 for s in settles[1:]] or [settles[0].wall_s * 1000]
 
 
 class FrontierPolicy:
@@ -225,31 +233,17 @@ class FrontierPolicy:
         return []
 
 
-class ViewpointPolicy:
+class ViewpointPolicy(AbstractMapPolicy):
     """Negative information: to where the goal's label may still be read, growing the model when it is used up."""
 
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
-        self.params = params
-        self.nav = Navigator.start(world, goal, start, params=params.navigator)
-        self.drive = DriveStack(params)
+        super().__init__(world, goal, start, params)
         self.swept: SweptSpace | None = None
         self.belief: Belief | None = None
         self.views: Viewpoints | None = None
         self.target: np.ndarray | None = None
-        self.target_at = -float("inf")
         self.swept_at = -float("inf")
         self.visited: list[np.ndarray] = []
-        self.bumps = 0  # exploration bumps in all
-        self.gave_up = ""
-
-    @property
-    def cues(self) -> list[CueEvent]:
-        return self.nav.cues
-
-    def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
-                grid: OccupancyGrid) -> None:
-        if self.nav.observe(sightings, t_s=t_s, distance_m=distance_m, explored_centre=grid.explored_centre):
-            self.target = None
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:
@@ -318,10 +312,6 @@ class ViewpointPolicy:
         if self.swept is not None:
             out["swept"] = self.swept.swept
         return out
-
-    def settle_ms(self) -> list[float]:
-        settles = self.nav.settles
-        return [s.wall_s * 1000 for s in settles[1:]] or [settles[0].wall_s * 1000]
 
 
 NAVIGATORS: dict[str, type] = {
