@@ -25,6 +25,7 @@ from abstract_map.cli import main
 from abstract_map.errors import AbstractMapError
 from abstract_map.grammar import parse_cue
 from tests.conftest import slow_property
+from tests.json_edits import leaves, set_path
 
 from .test_imagine_command import GOOD
 from .test_reliability import state, zoo_map
@@ -83,24 +84,8 @@ def test_any_cue_works_or_is_refused_changing_nothing(text, tag, pose, kind, tag
     assert finite(model)
 
 
-def set_path(data: Any, path: list[Any], value: Any) -> Any:
-    data = copy.deepcopy(data)
-    node = data
-    for key in path[:-1]:
-        node = node[key]
-    node[path[-1]] = value
-    return data
 
 
-def leaves(data: Any, prefix: tuple = ()) -> list[list[Any]]:
-    out = [list(prefix)] if prefix else []
-    if isinstance(data, dict):
-        for key, value in data.items():
-            out += leaves(value, prefix + (key,))
-    elif isinstance(data, list):
-        for i, value in enumerate(data):
-            out += leaves(value, prefix + (i,))
-    return out
 
 
 def scenario_strategy() -> st.SearchStrategy[Any]:

@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import copy
 import json
 import math
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
@@ -16,6 +14,7 @@ from hypothesis import strategies as st
 from abstract_map.errors import AbstractMapError
 from sim.world.data import WorldError, load_world
 from tests.conftest import slow_property
+from tests.json_edits import leaves, set_path
 
 
 def edit(root: Path, name: str, change) -> Path:
@@ -92,15 +91,6 @@ def test_issue9_item4_a_600_level_hierarchy_loads(tmp_path, tiny_world_writer):
     assert world.goals == {"A": 0}
 
 
-def leaves(data: Any, prefix: tuple = ()) -> list[list[Any]]:
-    out = [list(prefix)] if prefix else []
-    if isinstance(data, dict):
-        for key, value in data.items():
-            out += leaves(value, prefix + (key,))
-    elif isinstance(data, list):
-        for i, value in enumerate(data):
-            out += leaves(value, prefix + (i,))
-    return out
 
 
 
@@ -121,14 +111,13 @@ def template(tmp_path_factory, tiny_world_writer):
 @given(which=st.sampled_from(["world.json", "tags.json"]), index=st.integers(0, 10_000), value=HOSTILE)
 def test_any_world_folder_loads_and_works_or_is_refused(tmp_path_factory, tiny_world_writer, template, which, index,
                                                          value):
-    meta, tags = copy.deepcopy(template)
-    data = meta if which == "world.json" else tags
-    spots = leaves(data)
+    meta, tags = template
+    spots = leaves(meta if which == "world.json" else tags)
     path = spots[index % len(spots)]
-    node = data
-    for key in path[:-1]:
-        node = node[key]
-    node[path[-1]] = value
+    if which == "world.json":
+        meta = set_path(meta, path, value)
+    else:
+        tags = set_path(tags, path, value)
     root = tiny_world_writer(tmp_path_factory.mktemp("world") / "w")
     (root / "world.json").write_text(json.dumps(meta, allow_nan=True))
     (root / "tags.json").write_text(json.dumps(tags, allow_nan=True))
