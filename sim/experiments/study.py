@@ -101,6 +101,40 @@ def run_spec(spec: TrialSpec) -> dict[str, Any]:
     return label_record(record, spec)
 
 
+def shares_run(spec: TrialSpec) -> tuple[str, str, int, str, str] | None:
+    """Specs with the same key share one run: a goal-blind navigator's path is the same whatever the goal."""
+    from sim.navigation.policies import NAVIGATORS
+
+    if not getattr(NAVIGATORS.get(spec.navigator), "goal_blind", False) or spec.log_dir is not None:
+        return None
+    return spec.world, spec.navigator, spec.seed, spec.perception, json.dumps(asdict(spec.params), sort_keys=True)
+
+
+def run_unit(unit: tuple[TrialSpec, ...]) -> list[dict[str, Any]]:
+    """Run the trials of ``unit`` (specs that share one run, or a single spec); one record per spec, in order.
+
+    A shared run watches every goal of the unit until all are read or a cap is hit; each goal's record is the
+    run up to its label's first read (:meth:`sim.experiments.trial.Trial.result_for`). Never raises.
+    """
+    if len(unit) == 1:
+        return [run_spec(unit[0])]
+    began = time.perf_counter()
+    first = unit[0]
+    try:
+        from sim.experiments.trial import Trial
+
+        with Trial(first.world, first.goal, seed=first.seed, perception=first.perception, navigator=first.navigator,
+                   params=first.params, also=[s.goal for s in unit[1:]]) as trial:
+            while not trial.done:
+                trial.step()
+            return [label_record(trial.result_for(spec.goal).to_dict(), spec) for spec in unit]
+    except Exception as exc:  # a failed run is data, not a crash of the study
+        return [label_record({"goal": spec.goal, "seed": spec.seed, "perception": spec.perception,
+                              "success": False, "reason": f"error: {type(exc).__name__}: {exc}",
+                              "distance_m": None, "sim_s": 0.0, "wall_s": round(time.perf_counter() - began, 2),
+                              "traceback": traceback.format_exc()}, spec) for spec in unit]
+
+
 def label_record(record: dict[str, Any], spec: TrialSpec) -> dict[str, Any]:
     """The record with its study key and scores: world, navigator, style, signage, oracle_m, spl, ratio."""
     distance = record.get("distance_m")
@@ -112,6 +146,10 @@ def label_record(record: dict[str, Any], spec: TrialSpec) -> dict[str, Any]:
             "oracle_ratio": None if ratio is None else round(ratio, 4)}
 
 
+Unit = Any  # what an executor maps over: here a tuple of trial specs sharing one run
+Result = Any  # what the mapped function returns for one unit
+
+
 class ProcessExecutor:
     """A local pool of worker processes."""
 
@@ -120,8 +158,7 @@ class ProcessExecutor:
             raise ValueError("--address is only for the ray executor")
         self.workers = max(1, workers)
 
-    def map_unordered(self, fn: Callable[[TrialSpec], dict[str, Any]],
-                      specs: list[TrialSpec]) -> Iterator[tuple[TrialSpec, dict[str, Any]]]:
+    def map_unordered(self, fn: Callable[[Unit], Result], specs: list[Unit]) -> Iterator[tuple[Unit, Result]]:
         if self.workers == 1:
             for spec in specs:
                 yield spec, fn(spec)
@@ -150,8 +187,7 @@ class RayExecutor:
             else:
                 ray.init(num_cpus=max(1, workers), include_dashboard=False, log_to_driver=False)
 
-    def map_unordered(self, fn: Callable[[TrialSpec], dict[str, Any]],
-                      specs: list[TrialSpec]) -> Iterator[tuple[TrialSpec, dict[str, Any]]]:
+    def map_unordered(self, fn: Callable[[Unit], Result], specs: list[Unit]) -> Iterator[tuple[Unit, Result]]:
         remote = self.ray.remote(num_cpus=1)(fn)
         pending = {remote.remote(spec): spec for spec in specs}
         while pending:
@@ -251,7 +287,8 @@ def run_study(specs: list[TrialSpec], out: Path, *, executor: ProcessExecutor | 
               progress: Callable[[int, int, dict[str, Any] | None], None] | None = None) -> list[dict[str, Any]]:
     """Run the specs not yet done in ``out/trials``; return every trial's record (done before or now).
 
-    Also writes ``out/trials.csv``, one row per trial.
+    Specs of a goal-blind navigator that differ only by goal share one run (:func:`shares_run`). Also writes
+    ``out/trials.csv``, one row per trial.
     """
     specs = list({s.key: s for s in specs}.values())
     folder = out / "trials"
@@ -263,11 +300,16 @@ def run_study(specs: list[TrialSpec], out: Path, *, executor: ProcessExecutor | 
     todo = [s for s in specs if s.key not in records]
     if progress:
         progress(len(records), len(specs), None)
-    for spec, record in executor.map_unordered(run_spec, todo):
-        write_atomic(folder / f"{spec.key}.json", json.dumps(record))
-        records[spec.key] = record
-        if progress:
-            progress(len(records), len(specs), record)
+    shared: dict[object, list[TrialSpec]] = {}
+    for spec in todo:
+        shared.setdefault(shares_run(spec) or spec.key, []).append(spec)
+    units = [tuple(group) for group in shared.values()]
+    for unit, unit_records in executor.map_unordered(run_unit, units):
+        for spec, record in zip(unit, unit_records):
+            write_atomic(folder / f"{spec.key}.json", json.dumps(record))
+            records[spec.key] = record
+            if progress:
+                progress(len(records), len(specs), record)
     ordered = [records[s.key] for s in specs]
     write_csv(ordered, out / "trials.csv")
     return ordered

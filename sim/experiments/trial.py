@@ -12,8 +12,8 @@ from __future__ import annotations
 import math
 import os
 import time
-from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -23,7 +23,7 @@ from sim.navigation.belief import BeliefParams
 from sim.navigation.follower import FollowerParams
 from sim.navigation.navigator import CueEvent, NavigatorParams
 from sim.navigation.planner import PlannerParams
-from sim.navigation.policies import PolicyParams, make_policy
+from sim.navigation.policies import NAVIGATORS, PolicyParams, make_policy
 from sim.navigation.replanner import ReplanParams
 from sim.navigation.targeting import TargetParams
 from sim.navigation.viewpoints import ViewpointParams
@@ -74,6 +74,18 @@ class Frame:
     target: tuple[float, float]
     path: np.ndarray | None
     layers: dict[str, np.ndarray] = field(default_factory=dict)  # uint8 (0-255) images on the grid, e.g. belief
+
+
+@dataclass(frozen=True)
+class Reading:
+    """The moment a watched goal's label was first read."""
+
+    t_s: float  # s of simulated time
+    distance_m: float  # m driven by then
+    wall_s: float  # s of wall time since the trial began
+    cpu_s: float  # s of this process's CPU time since the trial began
+    trajectory_len: int  # trajectory samples recorded by then
+    pose: tuple[float, float, float]  # true pose then (m, m, rad)
 
 
 @dataclass
@@ -156,18 +168,27 @@ class Trial:
     senses at the rates in :class:`TrialParams`. :attr:`done` turns true when
     the goal's label is read, a cap is hit or exploration is exhausted, with
     :attr:`reason` saying which. Always :meth:`close` it (or use ``with``).
+
+    ``also`` names further goals to watch for a navigator that never reads a
+    sign (``goal_blind``): its path does not depend on the goal, so one run
+    that goes on until every watched label is read stands for one trial per
+    goal (:meth:`result_for`), exactly as separate runs with the same seed.
     """
 
     def __init__(self, world: World | str, goal: str, *, seed: int = 0, perception: str = "camera",
                  navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
-                 record: bool = False) -> None:
+                 record: bool = False, also: Sequence[str] = ()) -> None:
         self.began = time.perf_counter()
         self.began_cpu = time.process_time()
         self.world = load_world(world) if isinstance(world, str) else world
         self.params = params = params or TrialParams()
-        if goal not in self.world.goals and not self.world.label_tags(goal):
-            raise ValueError(f"goal {goal!r}: no label in world {self.world.name!r}; "
-                             f"study goals: {sorted(self.world.goals)}")
+        for name in (goal, *also):
+            if name not in self.world.goals and not self.world.label_tags(name):
+                raise ValueError(f"goal {name!r}: no label in world {self.world.name!r}; "
+                                 f"study goals: {sorted(self.world.goals)}")
+        if also and not getattr(NAVIGATORS.get(navigator), "goal_blind", False):
+            raise ValueError(f"navigator {navigator!r} reads signs, so its path depends on the goal: "
+                             "one run cannot stand for several goals")
         self.goal, self.seed, self.mode = goal, seed, perception
         self.progress, self.record = progress, record
         self.observers: list[Observer] = []
@@ -186,8 +207,11 @@ class Trial:
         self.angles = laser_angles(params.laser)
         self.navigator = navigator
         self.policy = make_policy(navigator, self.world, goal, self.start, policy_params(params))
-        self.goal_tags = {tag.id for tag in self.world.tags.values()
-                          if tag.kind == "label" and tag.text.casefold() == goal.casefold()}
+        self.watched = {name: {tag.id for tag in self.world.tags.values()
+                               if tag.kind == "label" and tag.text.casefold() == name.casefold()}
+                        for name in dict.fromkeys((goal, *also))}
+        self.goal_tags = self.watched[goal]
+        self.readings: dict[str, Reading] = {}  # watched goal -> when its label was first read
         self.success = False
         self.steps_per_tick = max(1, round(1.0 / params.control_hz / scene.time_step))
         self.tick = self.steps_per_tick * scene.time_step  # s of simulated time per step
@@ -230,7 +254,13 @@ class Trial:
         if self.n % self.every["see"] == 0:
             self.sightings = self.sensor.observe(self.robot)
             self.policy.observe(self.sightings, t_s=self.t, distance_m=self.distance, grid=self.grid)
-            if any(s.tag_id in self.goal_tags for s in self.sightings):
+            seen = {s.tag_id for s in self.sightings}
+            for name, tags in self.watched.items():
+                if name not in self.readings and tags & seen:
+                    self.readings[name] = Reading(self.t, self.distance, time.perf_counter() - self.began,
+                                                  time.process_time() - self.began_cpu, len(self.trajectory),
+                                                  self.robot.true_pose())
+            if len(self.readings) == len(self.watched):
                 self.success = True
                 self.reason = "goal label read"
                 return
@@ -294,6 +324,20 @@ class Trial:
             settle_median_ms=float(np.median(settle_ms)) if settle_ms else 0.0, frames=frames,
             grid_extent=self.grid.extent, navigator=self.navigator, cpu_s=time.process_time() - self.began_cpu,
         )
+
+
+    def result_for(self, goal: str) -> TrialResult:
+        """The result a trial of ``goal`` alone (a watched goal) would have given: up to its label's first read,
+        or the whole run when it was never read."""
+        result = self.result()
+        reading = self.readings.get(goal)
+        if reading is None:
+            return replace(result, goal=goal, success=False,
+                           reason=self.reason if self.reason != "goal label read" else "not read")
+        trajectory = np.array([*self.trajectory[:reading.trajectory_len], (reading.t_s, *reading.pose)])
+        return replace(result, goal=goal, success=True, reason="goal label read", distance_m=reading.distance_m,
+                       sim_s=reading.t_s, wall_s=reading.wall_s, cpu_s=reading.cpu_s, trajectory=trajectory,
+                       frames=[f for f in result.frames if f.t_s <= reading.t_s])
 
 
 def run_trial(world: World | str, goal: str, *, seed: int = 0, perception: str = "camera",

@@ -180,6 +180,8 @@ class FrontierPolicy:
     on a frontier; a reached or unreachable one is never chosen again.
     """
 
+    goal_blind = True  # its path never depends on the goal, so one run can stand for every goal of a world
+
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams,
                  frontier: FrontierParams | None = None) -> None:
         self.params = params

@@ -17,10 +17,10 @@ class FakeExecutor:
     def __init__(self) -> None:
         self.ran: list[TrialSpec] = []
 
-    def map_unordered(self, fn, specs):
-        for spec in specs:
-            self.ran.append(spec)
-            yield spec, fake_run(spec)
+    def map_unordered(self, fn, units):
+        for unit in units:
+            self.ran.extend(unit)
+            yield unit, [fake_run(spec) for spec in unit]
 
 
 def fake_run(spec: TrialSpec) -> dict:

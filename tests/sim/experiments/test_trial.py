@@ -62,3 +62,33 @@ def test_trial_command_rejects_an_unknown_world(tmp_path, capsys):
 
     assert main(["trial", "--world", str(tmp_path / "nowhere"), "--goal", "A", "--out", str(tmp_path)]) == 2
     assert "nowhere" in capsys.readouterr().err
+
+
+def test_one_goal_blind_run_stands_for_one_trial_per_goal(tmp_path):
+    """The frontier's path ignores the goal: a shared run watching two goals gives each goal's own trial."""
+    from sim.experiments.trial import Trial
+    from sim.world.data import load_world
+    from sim.world.generator import generated_world
+
+    world = load_world(generated_world(4, style="office", size="small", root=tmp_path))
+    goals = ["Design Storeroom", "Admin Office"]  # the first is read within a minute, the second is not
+    params = TrialParams(max_sim_s=60.0, start_jitter_m=0.1, detection_noise_m=0.03)
+    with Trial(world, goals[0], seed=2, perception="geometric", navigator="frontier", params=params,
+               also=goals[1:]) as shared:
+        while not shared.done:
+            shared.step()
+        together = {goal: shared.result_for(goal) for goal in goals}
+    assert together["Design Storeroom"].success and not together["Admin Office"].success
+    for goal in goals:
+        alone = run_trial(world, goal, seed=2, perception="geometric", navigator="frontier", params=params)
+        mine = together[goal]
+        assert (mine.success, mine.distance_m, mine.sim_s) == (alone.success, alone.distance_m, alone.sim_s)
+        assert mine.reason == alone.reason
+        assert np.allclose(mine.trajectory[-1], alone.trajectory[-1])
+
+
+def test_only_a_goal_blind_navigator_shares_a_run(tiny_world):
+    from sim.experiments.trial import Trial
+
+    with pytest.raises(ValueError, match="reads signs"):
+        Trial(tiny_world, "A", perception="geometric", navigator="paper", also=["A"])
