@@ -239,9 +239,13 @@ class StudySettings:
     navigators: tuple[str, ...]
     trials: int  # per goal and navigator
     goals: tuple[str, ...] | None = None  # None: every goal of every world
+    max_sim_s: float = TrialParams.max_sim_s  # s of simulated time before a trial fails
 
     def to_dict(self) -> dict[str, Any]:
-        return {"format": SETTINGS_FORMAT, **json.loads(json.dumps(asdict(self)))}
+        data = json.loads(json.dumps(asdict(self)))
+        if self.max_sim_s == TrialParams.max_sim_s:
+            del data["max_sim_s"]  # the default is left out, so folders from before the field resume
+        return {"format": SETTINGS_FORMAT, **data}
 
 
 def check_settings(out: Path, settings: StudySettings, *, record: bool = True) -> None:

@@ -52,6 +52,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--executor", default="process", choices=["process", "ray"],
                         help="local process pool (default) or Ray (needs the [ray] extra)")
     parser.add_argument("--address", help="Ray cluster address (with --executor ray); default: a local Ray")
+    parser.add_argument("--max-sim-s", type=float, default=900.0,
+                        help="cap on each trial's simulated seconds (default 900)")
     parser.add_argument("--out", type=Path, required=True, help="output folder (re-use it to resume)")
 
 
@@ -69,6 +71,8 @@ def run(args: argparse.Namespace) -> int:
 
     if args.trials < 1 or args.workers < 1:
         raise ExitError("--trials and --workers must be at least 1")
+    if not 1.0 <= args.max_sim_s <= 1e6:
+        raise ExitError(f"--max-sim-s {args.max_sim_s}: expected 1 to 1000000 simulated seconds")
     if args.goals and len(set(args.goals)) != len(args.goals):
         raise ExitError(f"--goals {args.goals}: a goal is named twice")
     if args.log:
@@ -80,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
             raise ExitError(str(exc)) from exc
     settings = StudySettings(worlds=tuple(args.world or ["zoo"]), perception=args.perception,
                              navigators=navigator_list(args.navigator), trials=args.trials,
-                             goals=tuple(args.goals) if args.goals else None)
+                             goals=tuple(args.goals) if args.goals else None, max_sim_s=args.max_sim_s)
     bars: list[Any] = []  # made at the first progress call, so a bad argument prints its one line alone
 
     def progress(done: int, total: int, record: dict[str, Any] | None) -> None:

@@ -32,6 +32,7 @@ from sim.experiments.study import (
     world_oracles,
     write_atomic,
 )
+from sim.experiments.trial import TrialParams
 from sim.experiments.world_spec import GeneratedSpec, generated_folder, parse_world_spec, resolve_worlds
 from sim.world.data import World, load_world
 
@@ -87,6 +88,7 @@ def plan_study(worlds: list[World], settings: StudySettings) -> list[TrialSpec]:
         goals = [g for g in world.goals if settings.goals is None or g in settings.goals]
         if goals:
             per_world.append(plan_specs(world, settings.trials, settings.perception, goals=goals,
+                                        base=TrialParams(max_sim_s=settings.max_sim_s),
                                         navigators=settings.navigators, oracle_m=world_oracles(world, goals)))
     # Round robin over worlds (each world's first goal and seed for every navigator, then the next...), so
     # the trials finished when a long study is stopped early spread over every world, style and signage level.

@@ -25,6 +25,7 @@ from sim.navigation.navigator import CueEvent, NavigatorParams
 from sim.navigation.planner import PlannerParams
 from sim.navigation.policies import NAVIGATORS, PolicyParams, make_policy
 from sim.navigation.replanner import ReplanParams
+from sim.navigation.routes import GuideParams, RouteParams
 from sim.navigation.targeting import TargetParams
 from sim.navigation.viewpoints import ViewpointParams
 from sim.perception import PERCEPTION_MODES, GeometricParams, Sighting, make_perception
@@ -59,6 +60,8 @@ class TrialParams:
     target_recheck_s: float = 5.0  # s between re-choosing the target when the model has not changed
     belief: BeliefParams = field(default_factory=BeliefParams)  # the viewpoint navigator's goal belief and sweep
     viewpoints: ViewpointParams = field(default_factory=ViewpointParams)  # ... and how it values viewpoints
+    routes: RouteParams = field(default_factory=RouteParams)  # ... and what arrows say of where the goal is
+    guide: GuideParams = field(default_factory=GuideParams)  # the guided search's trade of path against evidence
     laser: LaserParams = field(default_factory=LaserParams)
     occupancy_resolution_m: float = 0.1  # m, grid cell
 
@@ -151,7 +154,8 @@ def occupancy_grid(world: World, params: TrialParams) -> OccupancyGrid:
 def policy_params(params: TrialParams) -> PolicyParams:
     """The slice of the trial's parameters a navigation policy is built from."""
     return PolicyParams(params.navigator, params.planner, params.replan, params.follower, params.targeting,
-                        params.target_recheck_s, params.belief, params.viewpoints)
+                        params.target_recheck_s, params.belief, params.viewpoints, params.routes,
+                        params.guide)
 
 
 Observer = Callable[["Trial"], None]

@@ -41,10 +41,11 @@ class BeliefParams:
     normal_smoothing_m: float = 0.2  # m, std of the smoothing of the wall-orientation (structure) tensor
     corner_coherence: float = 0.3  # below this wall-orientation coherence (corners, specks) any view angle counts
     unknown_wall_prob: float = 0.05  # chance an unseen cell holds a label-bearing wall face, against a mapped face's 1
-    sigma_min_m: float = 2.0  # m, spread of the goal's prior with evidence right beside it
+    sigma_min_m: float = 5.0  # m, spread of the goal's prior even with evidence right beside it: on the development
+    # buildings the imagined goal lies a median of several metres from its label, often beyond a wall
     sigma_per_m: float = 0.35  # m of spread per m between the imagined goal and the nearest observed anchor
     label_offset_m: float = 2.0  # m, a place's label hangs about this far from the place (level-1 label length)
-    tail_weight: float = 0.15  # share of the prior in a wide tail: the model may be wrong (a sign misread, a guess)
+    tail_weight: float = 0.3  # share of the prior in a wide tail: the model may be wrong (a sign misread, a guess)
     tail_scale: float = 3.0  # the tail's spread, in multiples of sigma
 
 
@@ -205,11 +206,13 @@ def goal_sigma(goal_xy: np.ndarray, anchors_xy: np.ndarray, params: BeliefParams
 
 
 def goal_belief(grid: OccupancyGrid, swept: np.ndarray, goal_xy: np.ndarray, sigma_m: float,
-                params: BeliefParams) -> Belief:
-    """Posterior over the label's cell: prior x wall chance x (1 - detect_prob on swept cells).
+                params: BeliefParams, evidence: np.ndarray | None = None) -> Belief:
+    """Posterior over the label's cell: prior x evidence x wall chance x (1 - detect_prob on swept cells).
 
     The prior is a Gaussian of spread ``sigma_m`` about ``goal_xy`` mixed with a
-    wide tail (``tail_weight``, ``tail_scale`` times the spread).
+    wide tail (``tail_weight``, ``tail_scale`` times the spread). ``evidence``
+    (the grid's shape, e.g. :func:`sim.navigation.routes.route_likelihood` of
+    the arrows read) multiplies it.
 
     ``remaining`` is the posterior's normaliser against the prior's (both with
     each cell's wall chance): the share of the prior on wall not yet swept, near
@@ -224,6 +227,8 @@ def goal_belief(grid: OccupancyGrid, swept: np.ndarray, goal_xy: np.ndarray, sig
         gx = np.exp(-0.5 * ((xy_col - centre[0]) / spread) ** 2)
         gy = np.exp(-0.5 * ((xy_row - centre[1]) / spread) ** 2)
         prior += weight / spread ** 2 * np.outer(gy, gx)
+    if evidence is not None:
+        prior *= evidence
     wall = np.where(grid.occupied_mask(), 1.0, np.where(grid.free_mask(), 0.0, params.unknown_wall_prob))
     weighted = prior * wall
     posterior = weighted * np.where(swept, 1.0 - params.detect_prob, 1.0)

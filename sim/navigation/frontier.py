@@ -41,6 +41,7 @@ class FrontierParams:
     # m; cells this close in line of sight count as looked at: inside the 4 m reading range (geometric
     # perception, the oracle), with a margin for labels seen off their normal
     look_radius_m: float = 3.0
+    look_every_m: float = 0.1  # m the robot moves between looks (a look is all round; the map grows in between)
     look_rays: int = 180  # rays cast over the grid for :func:`look` (2 degrees apart: 10 cm apart at 3 m)
 
 
@@ -70,6 +71,21 @@ def look(grid: OccupancyGrid, covered: np.ndarray, robot_xy: np.ndarray, params:
     blocked_before = np.cumsum(occupied, axis=1) - occupied > 0
     mark = (~blocked_before).ravel() & inside & known
     covered[rc[mark, 0], rc[mark, 1]] = True
+
+
+def look_if_moved(grid: OccupancyGrid, covered: np.ndarray | None, looked: list[np.ndarray], robot_xy: np.ndarray,
+                  params: FrontierParams) -> np.ndarray:
+    """``covered`` (made when missing or of another shape) after a :func:`look` from ``robot_xy`` (m), taken only
+    when the robot has moved ``look_every_m`` since the latest look in ``looked`` (updated in place) or the map
+    has grown since: a look is all round, so turning on the spot adds nothing."""
+    if covered is None or covered.shape != grid.shape:
+        covered = np.zeros(grid.shape, dtype=bool)
+        looked.clear()
+    if looked and float(np.hypot(*(robot_xy - looked[0][:2]))) < params.look_every_m and looked[0][2] == grid.version:
+        return covered
+    look(grid, covered, robot_xy, params)
+    looked[:] = [np.array([robot_xy[0], robot_xy[1], grid.version])]
+    return covered
 
 
 def frontier_mask(grid: OccupancyGrid, robot_radius_m: float, params: FrontierParams,
@@ -122,9 +138,12 @@ def find_frontiers(grid: OccupancyGrid, robot_xy: np.ndarray, robot_radius_m: fl
 
 
 def nearest_frontier(grid: OccupancyGrid, robot_xy: np.ndarray, robot_radius_m: float, params: FrontierParams,
-                     visited: list[np.ndarray] | None = None,
-                     covered: np.ndarray | None = None) -> np.ndarray | None:
-    """The reachable frontier cell (m) nearest the robot by path, away from ``visited``; None if none is left."""
+                     visited: list[np.ndarray] | None = None, covered: np.ndarray | None = None,
+                     penalty_m: np.ndarray | None = None) -> np.ndarray | None:
+    """The reachable frontier cell (m) nearest the robot by path, away from ``visited``; None if none is left.
+
+    ``penalty_m`` (the grid's shape, m) is added to each cell's path length: a guided search's cost of
+    going where the cues say the goal is unlikely."""
     found = find_frontiers(grid, robot_xy, robot_radius_m, params, covered)
     candidates = found.mask & np.isfinite(found.distance_m) & (found.distance_m >= params.min_distance_m)
     cells = np.argwhere(candidates)
@@ -138,8 +157,10 @@ def nearest_frontier(grid: OccupancyGrid, robot_xy: np.ndarray, robot_radius_m: 
         cells, xy = cells[keep], xy[keep]
         if cells.size == 0:
             return None
-    best = np.argmin(found.distance_m[cells[:, 0], cells[:, 1]])
-    return xy[best]
+    cost = found.distance_m[cells[:, 0], cells[:, 1]]
+    if penalty_m is not None:
+        cost = cost + penalty_m[cells[:, 0], cells[:, 1]]
+    return xy[int(np.argmin(cost))]
 
 
 def still_frontier(grid: OccupancyGrid, target_xy: np.ndarray, robot_radius_m: float, params: FrontierParams,

@@ -23,19 +23,21 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Protocol
 
 import numpy as np
 
+from abstract_map.clauses import Locational
 from abstract_map.model import imagined_positions
 from sim.mapping.occupancy import OccupancyGrid
 from sim.navigation.belief import Belief, BeliefParams, SweptSpace, cue_mass, goal_belief, goal_sigma
 from sim.navigation.follower import FollowerParams, PathFollower, Recovery, RecoveryParams, StuckDetector, StuckParams
-from sim.navigation.frontier import FrontierParams, look, nearest_frontier, still_frontier
+from sim.navigation.frontier import FrontierParams, look_if_moved, nearest_frontier, still_frontier
 from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
 from sim.navigation.planner import Plan, PlannerParams
 from sim.navigation.replanner import Replanner, ReplanParams
+from sim.navigation.routes import Arrow, GuideParams, RouteParams, door_depth_weight, route_likelihood
 from sim.navigation.targeting import Target, TargetParams, choose_target
 from sim.navigation.viewpoints import ViewpointParams, Viewpoints, score_viewpoints, travel_costs
 from sim.perception.sighting import Sighting
@@ -56,6 +58,8 @@ class PolicyParams:
     target_recheck_s: float  # s between re-choosing the target when nothing new was read
     belief: BeliefParams = field(default_factory=BeliefParams)
     viewpoints: ViewpointParams = field(default_factory=ViewpointParams)
+    routes: RouteParams = field(default_factory=RouteParams)
+    guide: GuideParams = field(default_factory=GuideParams)
 
 
 class Policy(Protocol):
@@ -124,6 +128,12 @@ class AbstractMapPolicy:
         self.target_at = -float("inf")
         self.bumps = 0  # exploration bumps in all
         self.gave_up = ""
+        self.start = np.asarray(start, dtype=float)
+        self.depth = np.ones(1)  # door-depth weight per grid cell (sim.navigation.routes), set with the belief
+        self.evidence: np.ndarray | None = None  # depth x route likelihood, per grid cell
+        self.evidence_key: tuple[Arrow, ...] = ()
+        self.evidence_at = -float("inf")
+        self.now = 0.0  # s, simulated time of the latest command
 
     @property
     def cues(self) -> list[CueEvent]:
@@ -137,6 +147,36 @@ class AbstractMapPolicy:
     def settle_ms(self) -> list[float]:
         settles = self.nav.settles
         return [s.wall_s * 1000 for s in settles[1:]] or [settles[0].wall_s * 1000]
+
+    def arrows(self) -> list[Arrow]:
+        """Every arrow read that names the goal, or an area holding it (less surely)."""
+        model, rp = self.nav.model, self.params.routes
+        areas, place = set(), self.nav.goal
+        while place in model.hierarchy.parent and place not in areas:
+            place = model.hierarchy.parent[place]
+            areas.add(place)
+        out = []
+        for clause in model.clauses():
+            if not isinstance(clause, Locational) or clause.kind != "arrow" or clause.anchor not in model.fixed:
+                continue
+            if clause.toponym == self.nav.goal or clause.toponym in areas:
+                sign = model.fixed[clause.anchor]
+                wrong = rp.wrong_prob if clause.toponym == self.nav.goal else rp.area_wrong_prob
+                out.append(Arrow((sign.x, sign.y), sign.theta, clause.direction, wrong))
+        return out
+
+    def _evidence(self, grid: OccupancyGrid) -> np.ndarray:
+        """Door depth x route likelihood of the arrows read, per grid cell; refreshed when a new arrow is read
+        or every ``evidence_every_s`` (walls and doors are mapped slowly)."""
+        arrows = self.arrows()
+        key = tuple(arrows)
+        if self.evidence is None or key != self.evidence_key or self.now - self.evidence_at >= \
+                self.params.routes.evidence_every_s:
+            self.depth = door_depth_weight(grid, self.start[:2], self.params.routes)
+            likelihood = route_likelihood(grid, arrows, self.params.routes)
+            self.evidence = self.depth if likelihood is None else self.depth * likelihood
+            self.evidence_key, self.evidence_at = key, self.now
+        return self.evidence
 
 
 class PaperPolicy(AbstractMapPolicy):
@@ -193,6 +233,7 @@ class FrontierPolicy:
         self.checked_at = -float("inf")
         self.visited: list[np.ndarray] = []
         self.covered: np.ndarray | None = None  # bool, the grid's shape: cells looked at from within reading range
+        self.looked: list[np.ndarray] = []  # where the latest look was taken (m), at most one
 
     def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
                 grid: OccupancyGrid) -> None:
@@ -208,9 +249,7 @@ class FrontierPolicy:
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:
         radius = self.params.planner.robot_radius_m
-        if self.covered is None or self.covered.shape != grid.shape:
-            self.covered = np.zeros(grid.shape, dtype=bool)
-        look(grid, self.covered, np.array(pose[:2]), self.frontier)
+        self.covered = look_if_moved(grid, self.covered, self.looked, np.array(pose[:2]), self.frontier)
         if self.target is not None and t_s - self.checked_at >= self.frontier.recheck_s:
             self.checked_at = t_s
             if not still_frontier(grid, self.target, radius, self.frontier, self.covered):
@@ -250,6 +289,7 @@ class ViewpointPolicy(AbstractMapPolicy):
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:
         vp = self.params.viewpoints
+        self.now = t_s
         if self.swept is None:
             self.swept = SweptSpace(grid, self.params.belief)
         if t_s - self.swept_at >= vp.sweep_every_s:
@@ -271,7 +311,7 @@ class ViewpointPolicy(AbstractMapPolicy):
         goal = self.nav.model.goal_estimate()  # off the map too: the prior's near edge then lies on it
         anchors = np.array([f.xy for f in self.nav.model.fixed.values()])
         sigma = goal_sigma(goal, anchors, self.params.belief)
-        return goal_belief(grid, self.swept.swept, goal, sigma, self.params.belief)
+        return goal_belief(grid, self.swept.swept, goal, sigma, self.params.belief, self._evidence(grid))
 
     def _retarget(self, t_s: float, robot_xy: np.ndarray, grid: OccupancyGrid) -> None:
         """Choose the viewpoint reading the most belief per metre; grow the model while the belief is used up."""
@@ -283,7 +323,8 @@ class ViewpointPolicy(AbstractMapPolicy):
         if self.belief.remaining < vp.exhausted_remaining and self.nav.arrived_without_goal(grid.explored_centre()):
             self.bumps += 1
             self.belief = self._goal_belief(grid, robot_xy)
-        mass = self.belief.mass + vp.cue_weight * cue_mass(grid, self.swept.swept, robot_xy, vp.cue_radius_m, bp)
+        cues = cue_mass(grid, self.swept.swept, robot_xy, vp.cue_radius_m, bp) * self.depth
+        mass = self.belief.mass + vp.cue_weight * cues / max(float(cues.sum()), 1e-12)
         travel = travel_costs(grid, robot_xy, self.params.planner, vp.escape_cost, pool=vp.travel_pool)
         self.views = views = score_viewpoints(grid, travel, mass, vp, bp, self.visited)
         self.target_at = t_s
@@ -316,10 +357,90 @@ class ViewpointPolicy(AbstractMapPolicy):
         return out
 
 
+class GuidedPolicy(AbstractMapPolicy):
+    """Sign-guided frontier search: the frontier nearest by path plus a penalty for what the cues say.
+
+    The cost of a frontier cell is its path length plus ``penalty_m`` per e-fold
+    by which the evidence there falls short of the best: the abstract map's
+    imagined goal (the belief's Gaussian prior), every arrow read that names the
+    goal or an area holding it, and the doorways between the start and that
+    cell (:mod:`sim.navigation.routes`). Space counts as explored once looked at
+    from within reading range, as for ``frontier``; the goal is found when its
+    label is read. It gives up when no frontier is left.
+    """
+
+    def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
+        super().__init__(world, goal, start, params)
+        self.frontier = replace(FrontierParams(), min_distance_m=params.guide.min_target_m)
+        self.covered: np.ndarray | None = None
+        self.looked: list[np.ndarray] = []
+        self.visited: list[np.ndarray] = []
+        self.target: np.ndarray | None = None
+        self.checked_at = -float("inf")
+
+    def _penalty(self, grid: OccupancyGrid) -> np.ndarray:
+        """Per grid cell, the guide's penalty (m): ``penalty_m`` x -ln(evidence / its peak)."""
+        bp, gp = self.params.belief, self.params.guide
+        goal = self.nav.model.goal_estimate()
+        sigma = goal_sigma(goal, np.array([f.xy for f in self.nav.model.fixed.values()]), bp)
+        rows, cols = grid.shape
+        x = grid.cell_to_world(np.stack([np.zeros(cols), np.arange(cols)], axis=1))[:, 0] - goal[0]
+        y = grid.cell_to_world(np.stack([np.arange(rows), np.zeros(rows)], axis=1))[:, 1] - goal[1]
+        d2 = y[:, None] ** 2 + x[None, :] ** 2
+        wide = bp.tail_scale * sigma
+        prior = (1 - bp.tail_weight) * np.exp(-0.5 * d2 / sigma ** 2) + bp.tail_weight * np.exp(-0.5 * d2 / wide ** 2)
+        evidence = prior * self._evidence(grid)
+        return gp.penalty_m * -np.log(np.maximum(evidence / max(float(evidence.max()), 1e-300), gp.floor))
+
+    def _choose(self, pose: Pose, grid: OccupancyGrid, t_s: float) -> None:
+        radius = self.params.planner.robot_radius_m
+        self.target = nearest_frontier(grid, np.array(pose[:2]), radius, self.frontier, self.visited, self.covered,
+                                       penalty_m=self._penalty(grid))
+        self.target_at = self.checked_at = t_s
+        if self.target is None:
+            self.gave_up = "no frontier left: explored all it could reach without reading the goal's label"
+        self.drive.replanner.request()
+
+    def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
+                rng: np.random.Generator) -> tuple[float, float]:
+        self.now = t_s
+        radius = self.params.planner.robot_radius_m
+        self.covered = look_if_moved(grid, self.covered, self.looked, np.array(pose[:2]), self.frontier)
+        if self.target is not None and t_s - self.checked_at >= self.frontier.recheck_s:
+            self.checked_at = t_s
+            if not still_frontier(grid, self.target, radius, self.frontier, self.covered):
+                self.target = None
+        if self.target is None or t_s - self.target_at >= self.params.guide.rechoose_s:
+            self._choose(pose, grid, t_s)
+            if self.target is None:
+                return 0.0, 0.0
+        assert self.target is not None
+        v, w, arrived = self.drive.drive(t_s, pose, grid, self.target, tick_s, self.params.navigator.arrive_m, rng)
+        if arrived:
+            self.visited.append(self.target)
+            self.target = None
+        return v, w
+
+    def picture(self) -> tuple[dict[str, tuple[float, float]], tuple[float, float], np.ndarray | None]:
+        plan = self.drive.plan
+        shown = (math.nan, math.nan) if self.target is None else (float(self.target[0]), float(self.target[1]))
+        return dict(imagined_positions(self.nav.model)), shown, None if plan is None else plan.waypoints
+
+    def layers(self) -> dict[str, np.ndarray]:
+        """For drawing, on the occupancy grid's cells: the evidence (depth x arrows) and the space looked at."""
+        out: dict[str, np.ndarray] = {}
+        if self.evidence is not None and self.evidence.size > 1:
+            out["belief"] = self.evidence
+        if self.covered is not None:
+            out["swept"] = self.covered
+        return out
+
+
 NAVIGATORS: dict[str, type] = {
     "paper": PaperPolicy,
     "frontier": FrontierPolicy,
     "viewpoint": ViewpointPolicy,
+    "guided": GuidedPolicy,
 }
 """Every navigation policy by its ``--navigator`` name; each is built as ``cls(world, goal, start, params)``."""
 

@@ -41,7 +41,7 @@ class ViewpointParams:
     keep_ratio: float = 0.75  # keep the current target while its score is at least this share of the best
     visited_radius_m: float = 1.0  # m; a viewpoint reached once is not a target again within this
     escape_cost: float = 20.0  # cost per cell of the impassable band right around the robot (it may be brushing)
-    retarget_s: float = 2.0  # s between re-valuing the viewpoints (the belief and map change as it drives)
+    retarget_s: float = 3.0  # s between re-valuing the viewpoints (the belief and map change as it drives)
     sweep_every_s: float = 0.25  # s between marking swept space (the perception looks at 4 Hz)
     exhausted_remaining: float = 0.2  # grow the model when less than this share of the goal's prior is left
 

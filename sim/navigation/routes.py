@@ -1,0 +1,168 @@
+"""Route evidence from arrows: where a place can lie, given that a sign's arrow points along its route.
+
+A sign's arrow points along the first leg of the shortest route from the sign
+to what it names (the convention of ``worlds/README.md``, which ``world check``
+tests to within 45 degrees). So a cell ``x`` is consistent with the arrow when
+setting off along it costs no detour: with ``s`` the spot in front of the sign,
+``p`` a probe ``lead_m`` along the arrow, and ``D_s``, ``D_p`` path lengths
+over the robot's map (mapped walls block, unseen space is open),
+
+    detour(x) = lead + D_p(x) - D_s(x)    (>= 0 by the triangle inequality)
+
+is near 0 where the route sets off along the arrow and near ``2 lead`` behind
+it. The likelihood of the arrow given the place at ``x`` is
+
+    L(x) = wrong + (1 - wrong) exp(-max(detour(x) - slack, 0) / scale)
+
+with ``wrong`` the chance the arrow is wrong (misleading signs) or, for an
+arrow naming an area that holds the place, that the area's route is not the
+place's. Early on, with nothing mapped, ``L`` is a soft cone about the arrow;
+as walls are mapped it follows corridors round corners.
+
+Labels hang beside doors on the side a door is approached from, so a room's
+inner walls carry only the labels of rooms reached through it. From the start
+(on a corridor or in a hall), :func:`door_depth_weight` counts the doorways
+(passages narrower than ``door_width_m``) a route must cross to reach the
+space in front of each wall, and weights a label there by ``room_weight`` per
+doorway: corridor-side walls first, through-rooms later, never never.
+World frame, metres.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+from skimage.graph import MCP_Geometric
+
+from sim.mapping.occupancy import OccupancyGrid
+
+
+@dataclass(frozen=True)
+class RouteParams:
+    """How arrows constrain where the goal can be."""
+
+    cell_m: float = 0.3  # m, coarse cells for route lengths: a 1 m door stays open, a 0.2 m wall still blocks
+    stand_m: float = 0.6  # m in front of the sign where a reader stands
+    lead_m: float = 2.0  # m along the arrow where the route's first leg is probed
+    slack_m: float = 0.6  # m of detour forgiven: a first leg 45 degrees off the arrow costs lead (1 - cos 45)
+    scale_m: float = 1.0  # m of further detour that divides the likelihood by e
+    wrong_prob: float = 0.1  # chance an arrow naming the goal is wrong ("misleading" signage: one in ten)
+    area_wrong_prob: float = 0.35  # for an arrow naming an area holding the goal: the goal may lie off the
+    # area's route (a wing's arrow leads to its nearest room, not to every room of it)
+    door_width_m: float = 1.3  # m; narrower passages are doorways (doors are ~1 m, corridors 1.8 m and wider)
+    robot_radius_m: float = 0.38  # m; narrower than twice this is no passage at all (the planner's radius)
+    door_penalty_m: float = 10.0  # m of route cost per metre walked through a doorway's narrows (counts doors)
+    door_cost_m: float = 14.0  # m of such cost one doorway adds (measured: 1 m door, 0.2 m wall, 0.2 m cells)
+    room_weight: float = 0.15  # label weight per doorway crossed: a through-room's label is rarer than a corridor's
+    front_m: float = 1.2  # m; a wall is weighed by the shallowest space this close in front of it
+    evidence_every_s: float = 8.0  # s between refreshing depth and route evidence (sooner on a new arrow)
+    depth_pool: int = 2  # doorways are counted on cells this many times the grid's (0.2 m: a door stays narrow)
+
+
+@dataclass(frozen=True)
+class GuideParams:
+    """How the guided search trades path length against what the cues say (``--navigator guided``)."""
+
+    penalty_m: float = 8.0  # m of path worth one e-fold of evidence: a room behind a door (x0.15) costs 15 m more,
+    # a place against an arrow (x0.1) 18 m more
+    floor: float = 1e-4  # evidence below this counts as this (a cap on the penalty: nowhere is ruled out)
+    rechoose_s: float = 5.0  # s between choosing the frontier afresh (the evidence changes as the map grows)
+    min_target_m: float = 1.0  # m; frontiers nearer than this by path are skipped (the robot sees them as it goes)
+
+
+@dataclass(frozen=True)
+class Arrow:
+    """One arrow read: a sign's pose and the direction it gives to a place."""
+
+    sign_xy: tuple[float, float]  # m
+    facing: float  # rad, the sign's facing (its normal, towards the reader)
+    direction: float  # rad, world frame, the arrow's direction
+    wrong_prob: float  # chance the arrow does not lead towards the goal
+
+
+def _coarse_blocked(grid: OccupancyGrid, pool: int) -> np.ndarray:
+    """Coarse cells (pool x pool fine cells) holding any mapped obstacle."""
+    occupied = grid.occupied_mask()
+    rows, cols = occupied.shape
+    pr, pc = -(-rows // pool) * pool, -(-cols // pool) * pool
+    padded = np.zeros((pr, pc), dtype=bool)
+    padded[:rows, :cols] = occupied
+    return padded.reshape(pr // pool, pool, pc // pool, pool).any(axis=(1, 3))
+
+
+def _cell(grid: OccupancyGrid, pool: int, blocked: np.ndarray, xy: np.ndarray) -> tuple[int, int] | None:
+    """The open coarse cell nearest to ``xy`` (m), or None when the grid has none."""
+    rc = grid.world_to_cell(xy)[0] // pool
+    rows, cols = blocked.shape
+    rc = np.clip(rc, 0, [rows - 1, cols - 1])
+    if not blocked[rc[0], rc[1]]:
+        return int(rc[0]), int(rc[1])
+    _, (ir, ic) = ndimage.distance_transform_edt(blocked, return_indices=True)
+    r, c = int(ir[rc[0], rc[1]]), int(ic[rc[0], rc[1]])
+    return None if blocked[r, c] else (r, c)
+
+
+def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: RouteParams = RouteParams()
+                     ) -> np.ndarray | None:
+    """The product over ``arrows`` of each one's likelihood, per cell of ``grid`` (float, max 1); None if none."""
+    arrows = list(arrows)
+    if not arrows:
+        return None
+    pool = max(1, round(params.cell_m / grid.resolution))
+    blocked = _coarse_blocked(grid, pool)
+    costs = np.where(blocked, np.inf, 1.0)
+    step = pool * grid.resolution
+    total = np.ones(blocked.shape)
+    for arrow in arrows:
+        sign = np.asarray(arrow.sign_xy, dtype=float)
+        stand = sign + params.stand_m * np.array([math.cos(arrow.facing), math.sin(arrow.facing)])
+        probe = stand + params.lead_m * np.array([math.cos(arrow.direction), math.sin(arrow.direction)])
+        s, p = _cell(grid, pool, blocked, stand), _cell(grid, pool, blocked, probe)
+        if s is None or p is None or s == p:
+            continue
+        d_s = MCP_Geometric(costs, fully_connected=True).find_costs([s])[0] * step
+        d_p = MCP_Geometric(costs, fully_connected=True).find_costs([p])[0] * step
+        lead = float(np.hypot(p[0] - s[0], p[1] - s[1])) * step
+        with np.errstate(invalid="ignore"):
+            detour = np.where(np.isfinite(d_s) & np.isfinite(d_p), lead + d_p - d_s, 0.0)
+        near = np.exp(-np.maximum(detour - params.slack_m, 0.0) / params.scale_m)
+        total *= arrow.wrong_prob + (1.0 - arrow.wrong_prob) * near
+    rows, cols = grid.shape
+    fine = np.repeat(np.repeat(total, pool, axis=0), pool, axis=1)[:rows, :cols]
+    return fine / float(fine.max())
+
+
+def door_depth_weight(grid: OccupancyGrid, start_xy: np.ndarray, params: RouteParams = RouteParams()) -> np.ndarray:
+    """Per cell, ``room_weight`` to the power of the doorways crossed from ``start_xy`` (m) to the space within
+    ``front_m`` of it (float, in (0, 1]; unseen space counts as open, mapped walls block).
+
+    Searched on cells ``depth_pool`` times coarser, each as narrow as its narrowest fine cell."""
+    pool = max(1, params.depth_pool)
+    res = grid.resolution * pool
+    clearance = ndimage.distance_transform_edt(~grid.occupied_mask()) * grid.resolution
+    rows, cols = clearance.shape
+    pr, pc = -(-rows // pool) * pool, -(-cols // pool) * pool
+    padded = np.zeros((pr, pc))
+    padded[:rows, :cols] = clearance
+    coarse = padded.reshape(pr // pool, pool, pc // pool, pool).min(axis=(1, 3))
+    passable = coarse > params.robot_radius_m
+    narrow = coarse < params.door_width_m / 2
+    rc = np.clip(grid.world_to_cell(np.asarray(start_xy, dtype=float))[0] // pool, 0,
+                 [pr // pool - 1, pc // pool - 1])
+    if not passable[rc[0], rc[1]]:
+        _, (ir, ic) = ndimage.distance_transform_edt(~passable, return_indices=True)
+        rc = np.array([ir[rc[0], rc[1]], ic[rc[0], rc[1]]])
+    seed = [tuple(int(v) for v in rc)]
+    cost = MCP_Geometric(np.where(passable, 1.0 + params.door_penalty_m * narrow, np.inf),
+                         fully_connected=True).find_costs(seed)[0] * res
+    plain = MCP_Geometric(np.where(passable, 1.0, np.inf), fully_connected=True).find_costs(seed)[0] * res
+    with np.errstate(invalid="ignore"):
+        doors = np.where(np.isfinite(cost) & np.isfinite(plain), (cost - plain) / params.door_cost_m, 6.0)
+    weight = params.room_weight ** np.clip(doors, 0.0, 6.0)
+    reach = max(1, int(round(params.front_m / res)))
+    front = ndimage.maximum_filter(weight, size=2 * reach + 1, mode="nearest")
+    return np.repeat(np.repeat(front, pool, axis=0), pool, axis=1)[:rows, :cols]

@@ -1,0 +1,65 @@
+"""Route evidence: arrows along the first leg of the route, and labels on the side a door is approached from."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
+from sim.navigation.routes import Arrow, RouteParams, door_depth_weight, route_likelihood
+
+
+def grid_of(walls: list[tuple[float, float, float, float]], size: tuple[float, float] = (20.0, 12.0)
+            ) -> OccupancyGrid:
+    """A grid mapped free everywhere but the given wall boxes (x0, x1, y0, y1 in m), which are mapped occupied."""
+    grid = OccupancyGrid(OccupancyParams(resolution_m=0.1, bounds=(0.0, size[0], 0.0, size[1])))
+    grid.log_odds[:] = -2.0
+    xy = grid.cell_to_world(np.argwhere(np.ones(grid.shape, dtype=bool)))
+    cells = grid.world_to_cell(xy)
+    for x0, x1, y0, y1 in walls:
+        inside = (xy[:, 0] >= x0) & (xy[:, 0] < x1) & (xy[:, 1] >= y0) & (xy[:, 1] < y1)
+        grid.log_odds[cells[inside, 0], cells[inside, 1]] = 3.0
+    return grid
+
+
+def at(grid: OccupancyGrid, field: np.ndarray, x: float, y: float) -> float:
+    r, c = grid.world_to_cell(np.array([x, y]))[0]
+    return float(field[r, c])
+
+
+def test_an_arrow_favours_what_lies_along_its_route_and_never_rules_out():
+    grid = grid_of([])
+    east = Arrow(sign_xy=(10.0, 1.0), facing=math.pi / 2, direction=0.0, wrong_prob=0.1)
+    likelihood = route_likelihood(grid, [east])
+    assert likelihood is not None and likelihood.shape == grid.shape
+    assert at(grid, likelihood, 17.0, 2.0) == pytest.approx(1.0, abs=0.05)  # ahead along the arrow
+    assert at(grid, likelihood, 3.0, 2.0) < 0.15  # behind it: only the chance the arrow is wrong
+    assert float(likelihood.min()) >= 0.1 - 1e-9
+    assert route_likelihood(grid, []) is None
+
+
+def test_route_likelihood_follows_a_corridor_round_its_corner():
+    """A wall north of the sign with a gap at its east end: an arrow east leads to the room north of the wall,
+    while a straight-line cone would have called it off the route only by the angle."""
+    wall = (0.0, 16.0, 4.0, 4.2)  # the gap is x 16 .. 20
+    grid = grid_of([wall])
+    east = Arrow(sign_xy=(4.0, 1.0), facing=math.pi / 2, direction=0.0, wrong_prob=0.1)
+    west = Arrow(sign_xy=(4.0, 1.0), facing=math.pi / 2, direction=math.pi, wrong_prob=0.1)
+    north_room = (2.0, 8.0)  # reached only round the east end of the wall
+    assert at(grid, route_likelihood(grid, [east]), *north_room) > 0.9
+    assert at(grid, route_likelihood(grid, [west]), *north_room) < 0.15
+
+
+def test_a_room_behind_a_door_weighs_less_than_the_corridor_it_opens_on():
+    """A 2 m corridor (y 0 .. 2) and a room above it (y 2.2 .. 8) entered by a 1 m door at x 9.5 .. 10.5."""
+    walls = [(0.0, 9.5, 2.0, 2.2), (10.5, 20.0, 2.0, 2.2)]
+    grid = grid_of(walls)
+    params = RouteParams()
+    weight = door_depth_weight(grid, np.array([2.0, 1.0]), params)
+    corridor_face, room_far_wall = (15.0, 1.9), (15.0, 7.0)
+    assert at(grid, weight, *corridor_face) == pytest.approx(1.0)
+    assert at(grid, weight, *room_far_wall) == pytest.approx(params.room_weight, rel=0.5)
+    wide = grid_of([(0.0, 8.0, 2.0, 2.2), (12.0, 20.0, 2.0, 2.2)])  # a 4 m opening: no door, one space
+    assert at(wide, door_depth_weight(wide, np.array([2.0, 1.0]), params), *room_far_wall) == pytest.approx(1.0)
