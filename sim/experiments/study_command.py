@@ -42,8 +42,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "repeatable (default: zoo)")
     parser.add_argument("--trials", type=int, default=5, help="trials per goal and navigator (default 5)")
     parser.add_argument("--navigator", action="append", metavar="NAME",
-                        help="paper (default; the paper's robot), frontier (reads no sign) and/or viewpoint "
-                             "(negative information); repeatable or a comma list, to compare them side by side")
+                        help="paper (default; the paper's robot), frontier (reads no sign), viewpoint "
+                             "(negative information) and/or guided (frontier search weighed by the cues); "
+                             "repeatable or a comma list, to compare them side by side")
     parser.add_argument("--workers", type=int, default=2, help="parallel trials (default 2)")
     parser.add_argument("--perception", default="camera", choices=["camera", "geometric"])
     parser.add_argument("--log", action="store_true",

@@ -40,8 +40,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="rendered camera + OpenCV AprilTag detector, or the fast geometric check")
     parser.add_argument("--navigator", default="paper",
                         help="navigation policy: paper (the paper's robot, reads signs; default), frontier "
-                             "(nearest frontier, reads no sign: the no-signs lower bound) or viewpoint (negative "
-                             "information: to where the goal's label may still be read)")
+                             "(nearest frontier, reads no sign: the no-signs lower bound), viewpoint (negative "
+                             "information: to where the goal's label may still be read) or guided (the nearest "
+                             "frontier weighed by what the arrows, doorways and abstract map say)")
     parser.add_argument("--out", type=Path, required=True, help="output folder")
     parser.add_argument("--record", action="store_true", help="also write DIR/run.gif, an animation of the run")
     parser.add_argument("--log", type=Path, metavar="FILE.rrd",

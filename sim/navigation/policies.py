@@ -394,8 +394,9 @@ class GuidedPolicy(AbstractMapPolicy):
 
     def _choose(self, pose: Pose, grid: OccupancyGrid, t_s: float) -> None:
         radius = self.params.planner.robot_radius_m
+        penalty = self._penalty(grid)
         self.target = nearest_frontier(grid, np.array(pose[:2]), radius, self.frontier, self.visited, self.covered,
-                                       penalty_m=self._penalty(grid))
+                                       penalty_m=penalty)
         self.target_at = self.checked_at = t_s
         if self.target is None:
             self.gave_up = "no frontier left: explored all it could reach without reading the goal's label"
