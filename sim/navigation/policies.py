@@ -22,7 +22,7 @@ differs is where it wants to go. Register a new one in :data:`NAVIGATORS`.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field, replace
 from typing import Protocol
 
@@ -142,7 +142,11 @@ class AbstractMapPolicy:
     def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
                 grid: OccupancyGrid) -> None:
         if self.nav.observe(sightings, t_s=t_s, distance_m=distance_m, explored_centre=grid.explored_centre):
-            self.target = None
+            self.forget_target()
+
+    def forget_target(self) -> None:
+        """The model changed: the target chosen from it is chosen again."""
+        self.target = None
 
     def settle_ms(self) -> list[float]:
         settles = self.nav.settles
@@ -210,54 +214,46 @@ class PaperPolicy(AbstractMapPolicy):
         return dict(imagined_positions(self.nav.model)), tuple(shown), None if plan is None else plan.waypoints
 
 
-class FrontierPolicy:
-    """Explore without reading signs: the nearest reachable frontier, until the goal's label is read.
+NO_FRONTIER = "no frontier left: explored all it could reach without reading the goal's label"
 
-    The trial judges success from the goal's label, so this policy ignores every
-    sighting. Space counts as explored once looked at from within reading range
+
+class FrontierSearch:
+    """The loop every frontier search shares: look, keep the target while it is still on a frontier, choose
+    afresh when it is reached or gone (and every ``rechoose_s``), drive to it.
+
+    Space counts as explored once looked at from within reading range
     (:func:`sim.navigation.frontier.look`), not merely swept by the 8 m laser. A
-    frontier target is dropped when it is reached, found unreachable or no longer
-    on a frontier; a reached or unreachable one is never chosen again.
+    reached or unreachable target is never chosen again. :attr:`exhausted`
+    turns true when no frontier is left.
     """
 
-    goal_blind = True  # its path never depends on the goal, so one run can stand for every goal of a world
-
-    def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams,
-                 frontier: FrontierParams | None = None) -> None:
-        self.params = params
-        self.frontier = frontier or FrontierParams()
-        self.drive = DriveStack(params)
-        self.cues: list[CueEvent] = []  # reads no sign
-        self.gave_up = ""
+    def __init__(self, params: PolicyParams, drive: DriveStack, frontier: FrontierParams,
+                 rechoose_s: float = math.inf) -> None:
+        self.params, self.drive, self.frontier, self.rechoose_s = params, drive, frontier, rechoose_s
         self.target: np.ndarray | None = None
-        self.checked_at = -float("inf")
+        self.chosen_at = self.checked_at = -float("inf")
         self.visited: list[np.ndarray] = []
         self.covered: np.ndarray | None = None  # bool, the grid's shape: cells looked at from within reading range
         self.looked: list[np.ndarray] = []  # where the latest look was taken (m), at most one
+        self.exhausted = False
 
-    def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
-                grid: OccupancyGrid) -> None:
-        """Signs are not read: nothing to take in."""
-
-    def _choose(self, pose: Pose, grid: OccupancyGrid) -> None:
-        radius = self.params.planner.robot_radius_m
-        self.target = nearest_frontier(grid, np.array(pose[:2]), radius, self.frontier, self.visited, self.covered)
-        if self.target is None:
-            self.gave_up = "no frontier left: explored all it could reach without reading the goal's label"
-        self.drive.replanner.request()
-
-    def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
-                rng: np.random.Generator) -> tuple[float, float]:
+    def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float, rng: np.random.Generator,
+                penalty: Callable[[], np.ndarray | None] = lambda: None) -> tuple[float, float]:
+        """The wheel command (m/s, rad/s) towards the frontier of least path length plus ``penalty()`` (m per
+        grid cell, or None)."""
         radius = self.params.planner.robot_radius_m
         self.covered = look_if_moved(grid, self.covered, self.looked, np.array(pose[:2]), self.frontier)
         if self.target is not None and t_s - self.checked_at >= self.frontier.recheck_s:
             self.checked_at = t_s
             if not still_frontier(grid, self.target, radius, self.frontier, self.covered):
                 self.target = None
-        if self.target is None:
-            self._choose(pose, grid)
-            self.checked_at = t_s
+        if self.target is None or t_s - self.chosen_at >= self.rechoose_s:
+            self.target = nearest_frontier(grid, np.array(pose[:2]), radius, self.frontier, self.visited,
+                                           self.covered, penalty_m=penalty())
+            self.chosen_at = self.checked_at = t_s
+            self.drive.replanner.request()
             if self.target is None:
+                self.exhausted = True
                 return 0.0, 0.0
         v, w, arrived = self.drive.drive(t_s, pose, grid, self.target, tick_s, self.params.navigator.arrive_m, rng)
         if arrived:
@@ -265,10 +261,42 @@ class FrontierPolicy:
             self.target = None
         return v, w
 
+    def shown(self) -> tuple[float, float]:
+        """The target (m) for drawing; NaN when there is none."""
+        return (math.nan, math.nan) if self.target is None else (float(self.target[0]), float(self.target[1]))
+
+
+class FrontierPolicy:
+    """Explore without reading signs: the nearest reachable frontier, until the goal's label is read.
+
+    The trial judges success from the goal's label, so this policy ignores every
+    sighting (:class:`FrontierSearch` with no penalty).
+    """
+
+    goal_blind = True  # its path never depends on the goal, so one run can stand for every goal of a world
+
+    def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams,
+                 frontier: FrontierParams | None = None) -> None:
+        self.params = params
+        self.drive = DriveStack(params)
+        self.search = FrontierSearch(params, self.drive, frontier or FrontierParams())
+        self.cues: list[CueEvent] = []  # reads no sign
+        self.gave_up = ""
+
+    def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
+                grid: OccupancyGrid) -> None:
+        """Signs are not read: nothing to take in."""
+
+    def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
+                rng: np.random.Generator) -> tuple[float, float]:
+        v, w = self.search.command(t_s, pose, grid, tick_s, rng)
+        if self.search.exhausted:
+            self.gave_up = NO_FRONTIER
+        return v, w
+
     def picture(self) -> tuple[dict[str, tuple[float, float]], tuple[float, float], np.ndarray | None]:
         plan = self.drive.plan
-        shown = (math.nan, math.nan) if self.target is None else (float(self.target[0]), float(self.target[1]))
-        return {}, shown, None if plan is None else plan.waypoints
+        return {}, self.search.shown(), None if plan is None else plan.waypoints
 
     def settle_ms(self) -> list[float]:
         return []
@@ -371,12 +399,11 @@ class GuidedPolicy(AbstractMapPolicy):
 
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
         super().__init__(world, goal, start, params)
-        self.frontier = replace(FrontierParams(), min_distance_m=params.guide.min_target_m)
-        self.covered: np.ndarray | None = None
-        self.looked: list[np.ndarray] = []
-        self.visited: list[np.ndarray] = []
-        self.target: np.ndarray | None = None
-        self.checked_at = -float("inf")
+        frontier = replace(FrontierParams(), min_distance_m=params.guide.min_target_m)
+        self.search = FrontierSearch(params, self.drive, frontier, params.guide.rechoose_s)
+
+    def forget_target(self) -> None:
+        self.search.target = None
 
     def _penalty(self, grid: OccupancyGrid) -> np.ndarray:
         """Per grid cell, the guide's penalty (m): ``penalty_m`` x -ln(evidence / its peak)."""
@@ -392,48 +419,25 @@ class GuidedPolicy(AbstractMapPolicy):
         evidence = prior * self._evidence(grid)
         return gp.penalty_m * -np.log(np.maximum(evidence / max(float(evidence.max()), 1e-300), gp.floor))
 
-    def _choose(self, pose: Pose, grid: OccupancyGrid, t_s: float) -> None:
-        radius = self.params.planner.robot_radius_m
-        penalty = self._penalty(grid)
-        self.target = nearest_frontier(grid, np.array(pose[:2]), radius, self.frontier, self.visited, self.covered,
-                                       penalty_m=penalty)
-        self.target_at = self.checked_at = t_s
-        if self.target is None:
-            self.gave_up = "no frontier left: explored all it could reach without reading the goal's label"
-        self.drive.replanner.request()
-
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:
         self.now = t_s
-        radius = self.params.planner.robot_radius_m
-        self.covered = look_if_moved(grid, self.covered, self.looked, np.array(pose[:2]), self.frontier)
-        if self.target is not None and t_s - self.checked_at >= self.frontier.recheck_s:
-            self.checked_at = t_s
-            if not still_frontier(grid, self.target, radius, self.frontier, self.covered):
-                self.target = None
-        if self.target is None or t_s - self.target_at >= self.params.guide.rechoose_s:
-            self._choose(pose, grid, t_s)
-            if self.target is None:
-                return 0.0, 0.0
-        assert self.target is not None
-        v, w, arrived = self.drive.drive(t_s, pose, grid, self.target, tick_s, self.params.navigator.arrive_m, rng)
-        if arrived:
-            self.visited.append(self.target)
-            self.target = None
+        v, w = self.search.command(t_s, pose, grid, tick_s, rng, penalty=lambda: self._penalty(grid))
+        if self.search.exhausted:
+            self.gave_up = NO_FRONTIER
         return v, w
 
     def picture(self) -> tuple[dict[str, tuple[float, float]], tuple[float, float], np.ndarray | None]:
         plan = self.drive.plan
-        shown = (math.nan, math.nan) if self.target is None else (float(self.target[0]), float(self.target[1]))
-        return dict(imagined_positions(self.nav.model)), shown, None if plan is None else plan.waypoints
+        return dict(imagined_positions(self.nav.model)), self.search.shown(), None if plan is None else plan.waypoints
 
     def layers(self) -> dict[str, np.ndarray]:
         """For drawing, on the occupancy grid's cells: the evidence (depth x arrows) and the space looked at."""
         out: dict[str, np.ndarray] = {}
         if self.evidence is not None and self.evidence.size > 1:
             out["belief"] = self.evidence
-        if self.covered is not None:
-            out["swept"] = self.covered
+        if self.search.covered is not None:
+            out["swept"] = self.search.covered
         return out
 
 
