@@ -16,9 +16,11 @@ class FakeExecutor:
 
     def __init__(self) -> None:
         self.ran: list[TrialSpec] = []
+        self.units: list[tuple[TrialSpec, ...]] = []
 
     def map_unordered(self, fn, units):
         for unit in units:
+            self.units.append(unit)
             self.ran.extend(unit)
             yield unit, [fake_run(spec) for spec in unit]
 
@@ -52,3 +54,19 @@ def test_a_goal_readable_from_the_start_reports_without_dividing_by_zero(tiny_wo
 
     row = GoalRow(goal="A", human=[], paper_robot=[], ours=[0.0], failures=0, oracle_m=0.0)
     assert "| A |" in report_markdown(tiny_world, [row], perception="geometric", trials=1, wall_s=1.0)
+
+
+def test_a_goal_blind_navigator_runs_once_per_world_and_seed_for_all_its_goals(tiny_world, tmp_path):
+    """frontier reads no sign: its trials of every goal share one run; paper's each run alone."""
+    from dataclasses import replace
+
+    base = plan_specs(tiny_world, 2, "geometric", navigators=("paper", "frontier"))
+    specs = base + [replace(s, goal="B") for s in base]  # a second goal (faked: nothing runs)
+    executor = FakeExecutor()
+    records = run_study(specs, tmp_path, executor=executor)
+    shared = [u for u in executor.units if u[0].navigator == "frontier"]
+    alone = [u for u in executor.units if u[0].navigator == "paper"]
+    assert sorted(len(u) for u in shared) == [2, 2] and {tuple(s.goal for s in u) for u in shared} == {("A", "B")}
+    assert all(len({(s.seed, s.world) for s in u}) == 1 for u in shared)  # one world and seed per run
+    assert len(alone) == 4 and all(len(u) == 1 for u in alone)
+    assert len(records) == 8
