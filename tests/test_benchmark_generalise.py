@@ -1,0 +1,24 @@
+"""The generalisation benchmark end to end on a tiny suite: one test building, a 10 s cap."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks" / "run.py"
+
+
+def test_a_tiny_generalise_suite_runs_and_tabulates(tmp_path, capsys, monkeypatch):
+    spec = importlib.util.spec_from_file_location("benchmarks_run", BENCHMARKS)
+    run = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, "benchmarks_run", run)  # dataclasses look their module up there
+    spec.loader.exec_module(run)
+    suite = run.GeneraliseSuite(buildings=1, camera_buildings=0, geometric=("frontier", "guided"), max_sim_s=10.0)
+    run.bench_generalise(suite, workers=1, out=tmp_path / "gen")
+    printed = capsys.readouterr().out
+    assert "| geometric  | frontier  | all" in printed and "| geometric  | guided    | all" in printed
+    records = run.finished_trials(tmp_path / "gen")
+    assert len(records) == 10  # 5 goals x 2 navigators; the frontier's 5 from one shared run
+    assert {r["world"] for r in records} == {"gen-office-medium-sparse-1000"}
+    assert all(r["sim_s"] <= 10.5 for r in records)
