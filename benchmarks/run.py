@@ -2,14 +2,19 @@
 
 Run from the repository root:
 
-    python benchmarks/run.py                  # settle, scaling, trials, study, generate (10-15 minutes on 2 cores)
-    python benchmarks/run.py settle scaling   # just some of: settle, scaling, trials, study, generate, generalise
+    python benchmarks/run.py                  # settle, campus, trials, study, generate, recording
+    python benchmarks/run.py settle campus    # just some of them
+    python benchmarks/run.py settle --against main   # the Lion replay on this checkout and on main, side by side
     python benchmarks/run.py generalise       # the generalisation benchmark (within an hour on 2 cores)
     python benchmarks/run.py generalise --buildings 6 --camera-buildings 2   # a quick run
 
-settle   median settle time per cue on the Lion replay (the authors' code: 1.5-5.6 s)
-scaling  settle time as the model grows: synthetic hierarchies of about 50, 500, 5,000 places with cues
-         (a few minutes: the 5,000-place model takes about 13 ms per integration step)
+settle   median CPU time per settle on the Lion replay (the authors' code: 1.5-5.6 s), steps, whether each
+         settle converged and how far the imagined Lion ends from its tag. --against REF also runs it on the
+         git ref REF (a temporary git worktree on PYTHONPATH) and prints the ratio of medians.
+campus   a robot walking a generated campus (benchmarks/campus.py), one cue at a time with a settle after
+         each: 500 places (the whole walk) and 5,000 (its first 30 cues; --cues N to change). Median and p95
+         settle, converged settles, peak memory, imagined-position error of places named but not yet seen.
+campus20k  the same at 20,000 places (its first 20 cues); named only
 trials   wall time and real-time factor of the Lion trial, per perception mode
 study    total wall time of a small study (1 trial per goal, geometric, 2 workers)
 generate time to generate a building per style and size, and how many pass the world check
@@ -25,12 +30,13 @@ recording  what a rerun recording (--log) costs: the Kingfisher trial with and w
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import statistics
 import sys
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -50,73 +56,109 @@ def table(title: str, header: list[str], rows: list[list[str]]) -> None:
         print("| " + " | ".join(str(x).ljust(w) for x, w in zip(row, widths)) + " |")
 
 
-def bench_settle() -> None:
-    from abstract_map.scenario import load_scenario, replay
-
-    scenario = load_scenario(ROOT / "worlds" / "zoo" / "lion_replay.json")
-    runs = [replay(scenario)[1] for _ in range(3)]
-    per_cue = [statistics.median(run[i]["wall_s"] for run in runs) for i in range(1, len(runs[0]))]
-    rows = [[run_cue["cue"], str(run_cue["iterations"]), f"{t * 1000:.1f}",
-             "({:.1f}, {:.1f})".format(*run_cue["goal"])] for run_cue, t in zip(runs[0][1:], per_cue)]
-    median = statistics.median(per_cue)
-    rows.append(["median", "", f"{median * 1000:.1f}", ""])
-    table("Settle time per cue, Lion replay (median of 3 runs)", ["cue", "steps", "ms", "Lion imagined at (m)"], rows)
-    low, high = AUTHORS_SETTLE_S
-    print(f"authors' implementation: {low}-{high} s per settle -> {low / median:.0f}x to {high / median:.0f}x faster")
+LION_TAG_XY = (-21.6996, 17.703)  # m, the Lion's label in worlds/zoo/tags.json (tag 17)
 
 
-Cue = tuple[int, str, tuple[float, float, float]]  # tag id, text, pose (x m, y m, theta rad)
+def lion_settles(checkout: Path, runs: int = 3) -> dict:
+    """The Lion replay's settles timed (CPU s) with ``checkout``'s abstract_map, in a child process."""
+    import json
+    import os
+    import subprocess
+
+    env = {**os.environ, "PYTHONPATH": str(checkout), "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+    out = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "lion_settles.py"),
+                          str(ROOT / "worlds" / "zoo" / "lion_replay.json"), str(runs)],
+                         env=env, cwd=checkout, capture_output=True, text=True, check=True)
+    result = json.loads(out.stdout.strip().splitlines()[-1])
+    if not Path(result["module"]).resolve().is_relative_to(checkout.resolve()):
+        raise RuntimeError(f"measured {result['module']}, not the checkout {checkout}")
+    per_cue = [statistics.median(run[i] for run in result["cpu_s"]) for i in range(len(result["cpu_s"][0]))]
+    result["per_cue"] = per_cue
+    result["median"] = statistics.median(per_cue)
+    result["lion_m"] = math.dist(result["goal"], LION_TAG_XY)
+    return result
 
 
-def synthetic(n_places: int, rng: np.random.Generator) -> tuple[dict, list[Cue]]:
-    """A campus of about ``n_places`` places (buildings of 10 rooms) and the cues a robot would read."""
-    n_buildings = max(1, round(n_places / 11))
-    tree = {"Campus": {f"B{b}": {f"B{b} R{r}": {} for r in range(10)} for b in range(n_buildings)}}
-    cues = []
-    size = 12.0 * math.sqrt(n_buildings)
-    for b in range(n_buildings):
-        bx, by = rng.uniform(-size, size, 2)
-        rooms = [f"B{b} R{r}" for r in range(10)]
-        cues.append((len(cues), f"$LEFT$ {rooms[0]}, {rooms[1]}\n$RIGHT$ {rooms[2]}\n{rooms[3]} is past {rooms[1]}",
-                     (bx, by, rng.uniform(-math.pi, math.pi))))
-        for r in rng.choice(10, 2, replace=False):
-            pose = (bx + rng.normal(0, 3), by + rng.normal(0, 3), rng.uniform(-math.pi, math.pi))
-            cues.append((len(cues), rooms[r], pose))
-    return tree, cues
+@contextlib.contextmanager
+def checkout(ref: str) -> Iterator[Path]:
+    """Git ref ``ref`` of this repository in a temporary worktree, removed afterwards."""
+    import subprocess
+
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "ref"
+        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(path), ref],
+                       check=True, capture_output=True)
+        try:
+            yield path
+        finally:
+            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(path)],
+                           check=False, capture_output=True)
 
 
-def bench_scaling(sizes: tuple[int, ...] = (50, 500, 5000)) -> None:
-    from abstract_map.hierarchy import Hierarchy
-    from abstract_map.model import AbstractMap
-    from abstract_map.params import AbstractMapParams, DynamicsParams
-
+def bench_settle(against: str | None = None, runs: int = 3) -> None:
+    """Median CPU per settle on the Lion replay; with ``against``, also on that git ref, side by side."""
+    results = {"this checkout": lion_settles(ROOT, runs)}
+    if against:
+        with checkout(against) as ref_dir:
+            results[against] = lion_settles(ref_dir, runs)
+            results["this checkout"] = lion_settles(ROOT, runs)  # again, after: load shared alike
+    names = list(results)
     rows = []
-    for n in sizes:
-        rng = np.random.default_rng(n)
-        tree, cues = synthetic(n, rng)
-        params = AbstractMapParams(dynamics=DynamicsParams(max_iterations=2000))
-        model = AbstractMap.from_hierarchy(Hierarchy.from_nested(tree), (0.0, 0.0, 0.0), params=params)
-        model.set_explored_centre((0.0, 0.0))
-        began = time.perf_counter()
-        model.settle()
-        first_s = time.perf_counter() - began
-        times, steps, settled = [], [], 0
-        batch = max(1, -(-len(cues) // 3))  # settle after every third of the cues
-        for i in range(0, len(cues), batch):
-            for tag, text, pose in cues[i:i + batch]:
-                model.observe_tag(tag, text, pose)
-            report = model.settle()
-            times.append(report.wall_s)
-            steps.append(report.iterations)
-            settled += report.settled
-        print(f"scaling: {n} places done", file=sys.stderr, flush=True)
-        rows.append([str(len(model.places())), str(len(model.springs())), f"{first_s * 1000:.0f}",
-                     f"{statistics.median(times) * 1000:.0f}", str(int(statistics.median(steps))),
-                     f"{statistics.median(t / s for t, s in zip(times, steps)) * 1000:.2f}",
-                     f"{settled}/{len(times)}"])
-    table("Settle time as the model grows (synthetic campus, settled after each third of its cues, 2,000-step cap)",
-          ["places", "springs", "hierarchy settle (ms)", "median settle with cues (ms)", "median steps",
-           "ms per step", "settled"], rows)
+    for i in range(len(results[names[0]]["per_cue"])):
+        rows.append([str(i + 1)] + [f"{results[n]['per_cue'][i] * 1000:.1f} ({results[n]['steps'][i]})"
+                                    for n in names])
+    rows.append(["median"] + [f"{results[n]['median'] * 1000:.1f}" for n in names])
+    rows.append(["settled"] + [f"{sum(results[n]['settled'])}/{len(results[n]['settled'])}" for n in names])
+    rows.append(["Lion from its tag (m)"] + [f"{results[n]['lion_m']:.2f}" for n in names])
+    table(f"CPU ms per settle (steps), Lion replay, median of {runs} runs", ["cue", *names], rows)
+    low, high = AUTHORS_SETTLE_S
+    median = results["this checkout"]["median"]
+    print(f"authors' implementation: {low}-{high} s per settle -> {low / median:.0f}x to {high / median:.0f}x faster")
+    if against:
+        print(f"median settle ratio {against} / this checkout: {results[against]['median'] / median:.2f}")
+
+
+CAMPUS_CUES = {500: None, 5000: 30, 20000: 20}  # cues walked per size (None: the whole walk)
+
+
+def campus_walk(checkout_dir: Path, n: int, cues: int | None) -> dict:
+    """benchmarks/campus.py at ``n`` places with ``checkout_dir``'s abstract_map, in a child process."""
+    import json
+    import os
+    import subprocess
+
+    command = [sys.executable, str(ROOT / "benchmarks" / "campus.py"), str(n), "--json"]
+    if cues is not None:
+        command += ["--cues", str(cues)]
+    env = {**os.environ, "PYTHONPATH": str(checkout_dir), "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+    out = subprocess.run(command, env=env, cwd=checkout_dir, capture_output=True, text=True, check=True)
+    figures = json.loads(out.stdout.strip().splitlines()[-1])
+    if not Path(figures["module"]).resolve().is_relative_to(checkout_dir.resolve()):
+        raise RuntimeError(f"measured {figures['module']}, not the checkout {checkout_dir}")
+    return figures
+
+
+def bench_campus(sizes: tuple[int, ...] = (500, 5000), cues: int | None = None, against: str | None = None) -> None:
+    """The campus walk (benchmarks/campus.py), one child process per size so peak memory is its own."""
+    runs: list[tuple[str, Path]] = [("this checkout", ROOT)]
+    with contextlib.ExitStack() as stack:
+        if against:
+            runs.append((against, stack.enter_context(checkout(against))))
+        rows = []
+        for n in sizes:
+            for name, path in runs:
+                f = campus_walk(path, n, cues if cues is not None else CAMPUS_CUES.get(n))
+                print(f"campus: {n} places done ({name})", file=sys.stderr, flush=True)
+                caps = f["caps"]
+                rows.append([name, str(f["places"]), f"{f['cues']}/{f['of_cues']}",
+                             f"{f['first_settle_cpu_s']:.1f}", f"{f['median_cpu_ms']:.0f}",
+                             f"{f['p95_cpu_ms']:.0f}", str(int(f["median_steps"])),
+                             f"{f['converged']}/{f['cues']}" + (f" ({caps['time']} at the time cap)"
+                                                                if caps.get("time") else ""),
+                             f"{f['peak_mb']:.0f}", f"{f['error_median_m']:.1f} / {f['guess_median_m']:.1f}"])
+    table("Campus walk: one cue at a time, a settle after each (CPU time)", [
+        "code", "places", "cues walked", "hierarchy settle (s)", "median ms/settle", "p95 ms", "median steps",
+        "converged", "peak MB", "named, unseen: median error / guess at sign (m)"], rows)
 
 
 def bench_trials(goal: str = "Lion") -> None:
@@ -276,10 +318,10 @@ def bench_recording(goal: str = "Kingfisher") -> None:
                                                             "CPU overhead (%)", "file (MB)"], rows)
 
 
-BENCHMARKS: dict[str, Callable[[], None]] = {"settle": bench_settle, "scaling": bench_scaling,
+BENCHMARKS: dict[str, Callable[[], None]] = {"settle": bench_settle, "campus": bench_campus,
                                              "trials": bench_trials, "study": bench_study,
                                              "generate": bench_generate, "recording": bench_recording}
-NAMED_ONLY = ("generalise",)  # too long for the default set; run by name
+NAMED_ONLY = ("generalise", "campus20k")  # too long for the default set (or superseded); run by name
 
 
 def main() -> int:
@@ -299,6 +341,9 @@ def main() -> int:
                         help="generalise: study folder, re-used to resume (default runs/generalise)")
     parser.add_argument("--report-only", action="store_true",
                         help="generalise: tabulate the trials finished so far in --out; run nothing")
+    parser.add_argument("--against", metavar="REF", default=None,
+                        help="settle, campus, campus20k: also run on this git ref (a temporary worktree)")
+    parser.add_argument("--cues", type=int, default=None, help="campus, campus20k: cues walked per size")
     args = parser.parse_args()
     unknown = [w for w in args.which if w not in BENCHMARKS and w not in NAMED_ONLY]
     if unknown:
@@ -312,6 +357,12 @@ def main() -> int:
             chosen = replace(suite, buildings=args.buildings, camera_buildings=args.camera_buildings,
                              max_sim_s=args.max_sim_s)
             bench_generalise(chosen, args.workers, args.out, args.report_only)
+        elif name == "settle":
+            bench_settle(args.against)
+        elif name == "campus":
+            bench_campus(cues=args.cues, against=args.against)
+        elif name == "campus20k":
+            bench_campus((20000,), cues=args.cues, against=args.against)
         else:
             BENCHMARKS[name]()
     return 0
