@@ -10,6 +10,7 @@ extent=grid.extent)`` and :func:`sim.perception.laser.grid_caster` can cast over
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,6 +96,13 @@ class OccupancyGrid:
         x = x0 + (rc[:, 1] + 0.5) * self.resolution
         y = y0 + (self.shape[0] - 1 - rc[:, 0] + 0.5) * self.resolution
         return np.stack([x, y], axis=1)
+
+    def cell_axes(self) -> tuple[np.ndarray, np.ndarray]:
+        """World x (m) of each column's cell centres (cols,) and world y (m) of each row's (rows,)."""
+        rows, cols = self.shape
+        x = self.cell_to_world(np.stack([np.zeros(cols), np.arange(cols)], axis=1))[:, 0]
+        y = self.cell_to_world(np.stack([np.arange(rows), np.zeros(rows)], axis=1))[:, 1]
+        return x, y
 
     def in_bounds(self, rc: np.ndarray) -> np.ndarray:
         """Which (row, col) indices (N, 2) lie inside the grid, shape (N,)."""
@@ -214,3 +222,18 @@ class OccupancyGrid:
         other.log_odds = self.log_odds.copy()
         other.version = self.version
         return other
+
+
+def pool_cells(values: np.ndarray, factor: int, fill: float | bool, reduce: Callable[..., np.ndarray]) -> np.ndarray:
+    """``values`` (rows, cols) in blocks of ``factor`` x ``factor`` cells, each block reduced to one cell by
+    ``reduce`` (e.g. ``np.min``, ``np.any``, called with ``axis``); the edges are padded with ``fill``."""
+    rows, cols = values.shape
+    pr, pc = -(-rows // factor) * factor, -(-cols // factor) * factor
+    padded = np.full((pr, pc), fill, dtype=values.dtype)
+    padded[:rows, :cols] = values
+    return reduce(padded.reshape(pr // factor, factor, pc // factor, factor), axis=(1, 3))
+
+
+def unpool_cells(values: np.ndarray, factor: int, shape: tuple[int, int]) -> np.ndarray:
+    """Each cell of pooled ``values`` repeated over its ``factor`` x ``factor`` block, cut to ``shape``."""
+    return np.repeat(np.repeat(values, factor, axis=0), factor, axis=1)[:shape[0], :shape[1]]

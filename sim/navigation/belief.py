@@ -219,10 +219,8 @@ def goal_belief(grid: OccupancyGrid, swept: np.ndarray, goal_xy: np.ndarray, sig
     1 when nothing near the goal has been looked at, near 0 when it all has.
     """
     centre = np.asarray(goal_xy, dtype=float)
-    rows, cols = grid.shape
-    xy_col = grid.cell_to_world(np.stack([np.zeros(cols), np.arange(cols)], axis=1))[:, 0]
-    xy_row = grid.cell_to_world(np.stack([np.arange(rows), np.zeros(rows)], axis=1))[:, 1]
-    prior = np.zeros((rows, cols))
+    xy_col, xy_row = grid.cell_axes()
+    prior = np.zeros(grid.shape)
     for weight, spread in ((1.0 - params.tail_weight, sigma_m), (params.tail_weight, params.tail_scale * sigma_m)):
         gx = np.exp(-0.5 * ((xy_col - centre[0]) / spread) ** 2)
         gy = np.exp(-0.5 * ((xy_row - centre[1]) / spread) ** 2)

@@ -73,19 +73,25 @@ def look(grid: OccupancyGrid, covered: np.ndarray, robot_xy: np.ndarray, params:
     covered[rc[mark, 0], rc[mark, 1]] = True
 
 
-def look_if_moved(grid: OccupancyGrid, covered: np.ndarray | None, looked: list[np.ndarray], robot_xy: np.ndarray,
-                  params: FrontierParams) -> np.ndarray:
-    """``covered`` (made when missing or of another shape) after a :func:`look` from ``robot_xy`` (m), taken only
-    when the robot has moved ``look_every_m`` since the latest look in ``looked`` (updated in place) or the map
-    has grown since: a look is all round, so turning on the spot adds nothing."""
-    if covered is None or covered.shape != grid.shape:
-        covered = np.zeros(grid.shape, dtype=bool)
-        looked.clear()
-    if looked and float(np.hypot(*(robot_xy - looked[0][:2]))) < params.look_every_m and looked[0][2] == grid.version:
-        return covered
-    look(grid, covered, robot_xy, params)
-    looked[:] = [np.array([robot_xy[0], robot_xy[1], grid.version])]
-    return covered
+@dataclass
+class LookedAt:
+    """The cells looked at from within reading range (:func:`look`) and where the latest look was taken."""
+
+    covered: np.ndarray | None = None  # bool, the grid's shape
+    at: tuple[float, float, int] | None = None  # x m, y m and the grid's version at the latest look
+
+    def update(self, grid: OccupancyGrid, robot_xy: np.ndarray, params: FrontierParams) -> np.ndarray:
+        """:attr:`covered` after a look from ``robot_xy`` (m), taken only when the robot has moved
+        ``look_every_m`` since the latest look or the map has grown since: a look is all round, so turning on
+        the spot adds nothing. A grid of another shape starts the record afresh."""
+        if self.covered is None or self.covered.shape != grid.shape:
+            self.covered, self.at = np.zeros(grid.shape, dtype=bool), None
+        if self.at is not None and self.at[2] == grid.version and \
+                float(np.hypot(robot_xy[0] - self.at[0], robot_xy[1] - self.at[1])) < params.look_every_m:
+            return self.covered
+        look(grid, self.covered, robot_xy, params)
+        self.at = (float(robot_xy[0]), float(robot_xy[1]), grid.version)
+        return self.covered
 
 
 def frontier_mask(grid: OccupancyGrid, robot_radius_m: float, params: FrontierParams,

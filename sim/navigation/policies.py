@@ -33,7 +33,7 @@ from abstract_map.model import imagined_positions
 from sim.mapping.occupancy import OccupancyGrid
 from sim.navigation.belief import Belief, BeliefParams, SweptSpace, cue_mass, goal_belief, goal_sigma
 from sim.navigation.follower import FollowerParams, PathFollower, Recovery, RecoveryParams, StuckDetector, StuckParams
-from sim.navigation.frontier import FrontierParams, look_if_moved, nearest_frontier, still_frontier
+from sim.navigation.frontier import FrontierParams, LookedAt, nearest_frontier, still_frontier
 from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
 from sim.navigation.planner import Plan, PlannerParams
 from sim.navigation.replanner import Replanner, ReplanParams
@@ -152,6 +152,13 @@ class AbstractMapPolicy:
         settles = self.nav.settles
         return [s.wall_s * 1000 for s in settles[1:]] or [settles[0].wall_s * 1000]
 
+    def goal_prior(self) -> tuple[np.ndarray, float]:
+        """The goal's imagined position (m; off the map too: a prior's near edge then lies on it) and the spread
+        (m) the model earns there (:func:`sim.navigation.belief.goal_sigma`)."""
+        goal = self.nav.model.goal_estimate()
+        anchors = np.array([f.xy for f in self.nav.model.fixed.values()])
+        return goal, goal_sigma(goal, anchors, self.params.belief)
+
     def arrows(self) -> list[Arrow]:
         """Every arrow read that names the goal, or an area holding it (less surely)."""
         model, rp = self.nav.model, self.params.routes
@@ -233,8 +240,7 @@ class FrontierSearch:
         self.target: np.ndarray | None = None
         self.chosen_at = self.checked_at = -float("inf")
         self.visited: list[np.ndarray] = []
-        self.covered: np.ndarray | None = None  # bool, the grid's shape: cells looked at from within reading range
-        self.looked: list[np.ndarray] = []  # where the latest look was taken (m), at most one
+        self.looked = LookedAt()
         self.exhausted = False
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float, rng: np.random.Generator,
@@ -242,14 +248,14 @@ class FrontierSearch:
         """The wheel command (m/s, rad/s) towards the frontier of least path length plus ``penalty()`` (m per
         grid cell, or None)."""
         radius = self.params.planner.robot_radius_m
-        self.covered = look_if_moved(grid, self.covered, self.looked, np.array(pose[:2]), self.frontier)
+        covered = self.looked.update(grid, np.array(pose[:2]), self.frontier)
         if self.target is not None and t_s - self.checked_at >= self.frontier.recheck_s:
             self.checked_at = t_s
-            if not still_frontier(grid, self.target, radius, self.frontier, self.covered):
+            if not still_frontier(grid, self.target, radius, self.frontier, covered):
                 self.target = None
         if self.target is None or t_s - self.chosen_at >= self.rechoose_s:
-            self.target = nearest_frontier(grid, np.array(pose[:2]), radius, self.frontier, self.visited,
-                                           self.covered, penalty_m=penalty())
+            self.target = nearest_frontier(grid, np.array(pose[:2]), radius, self.frontier, self.visited, covered,
+                                           penalty_m=penalty())
             self.chosen_at = self.checked_at = t_s
             self.drive.replanner.request()
             if self.target is None:
@@ -336,9 +342,7 @@ class ViewpointPolicy(AbstractMapPolicy):
 
     def _goal_belief(self, grid: OccupancyGrid, robot_xy: np.ndarray) -> Belief:
         assert self.swept is not None
-        goal = self.nav.model.goal_estimate()  # off the map too: the prior's near edge then lies on it
-        anchors = np.array([f.xy for f in self.nav.model.fixed.values()])
-        sigma = goal_sigma(goal, anchors, self.params.belief)
+        goal, sigma = self.goal_prior()
         return goal_belief(grid, self.swept.swept, goal, sigma, self.params.belief, self._evidence(grid))
 
     def _retarget(self, t_s: float, robot_xy: np.ndarray, grid: OccupancyGrid) -> None:
@@ -408,12 +412,9 @@ class GuidedPolicy(AbstractMapPolicy):
     def _penalty(self, grid: OccupancyGrid) -> np.ndarray:
         """Per grid cell, the guide's penalty (m): ``penalty_m`` x -ln(evidence / its peak)."""
         bp, gp = self.params.belief, self.params.guide
-        goal = self.nav.model.goal_estimate()
-        sigma = goal_sigma(goal, np.array([f.xy for f in self.nav.model.fixed.values()]), bp)
-        rows, cols = grid.shape
-        x = grid.cell_to_world(np.stack([np.zeros(cols), np.arange(cols)], axis=1))[:, 0] - goal[0]
-        y = grid.cell_to_world(np.stack([np.arange(rows), np.zeros(rows)], axis=1))[:, 1] - goal[1]
-        d2 = y[:, None] ** 2 + x[None, :] ** 2
+        goal, sigma = self.goal_prior()
+        x, y = grid.cell_axes()
+        d2 = (y[:, None] - goal[1]) ** 2 + (x[None, :] - goal[0]) ** 2
         wide = bp.tail_scale * sigma
         prior = (1 - bp.tail_weight) * np.exp(-0.5 * d2 / sigma ** 2) + bp.tail_weight * np.exp(-0.5 * d2 / wide ** 2)
         evidence = prior * self._evidence(grid)
@@ -436,8 +437,8 @@ class GuidedPolicy(AbstractMapPolicy):
         out: dict[str, np.ndarray] = {}
         if self.evidence is not None and self.evidence.size > 1:
             out["belief"] = self.evidence
-        if self.search.covered is not None:
-            out["swept"] = self.search.covered
+        if self.search.looked.covered is not None:
+            out["swept"] = self.search.looked.covered
         return out
 
 

@@ -38,7 +38,7 @@ import numpy as np
 from scipy import ndimage
 from skimage.graph import MCP_Geometric
 
-from sim.mapping.occupancy import OccupancyGrid
+from sim.mapping.occupancy import OccupancyGrid, pool_cells, unpool_cells
 
 
 @dataclass(frozen=True)
@@ -84,16 +84,6 @@ class Arrow:
     wrong_prob: float  # chance the arrow does not lead towards the goal
 
 
-def _coarse_blocked(grid: OccupancyGrid, pool: int) -> np.ndarray:
-    """Coarse cells (pool x pool fine cells) holding any mapped obstacle."""
-    occupied = grid.occupied_mask()
-    rows, cols = occupied.shape
-    pr, pc = -(-rows // pool) * pool, -(-cols // pool) * pool
-    padded = np.zeros((pr, pc), dtype=bool)
-    padded[:rows, :cols] = occupied
-    return padded.reshape(pr // pool, pool, pc // pool, pool).any(axis=(1, 3))
-
-
 def _cell(grid: OccupancyGrid, pool: int, blocked: np.ndarray, xy: np.ndarray) -> tuple[int, int] | None:
     """The open coarse cell nearest to ``xy`` (m), or None when the grid has none."""
     rc = grid.world_to_cell(xy)[0] // pool
@@ -113,7 +103,7 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
     if not arrows:
         return None
     pool = max(1, round(params.cell_m / grid.resolution))
-    blocked = _coarse_blocked(grid, pool)
+    blocked = pool_cells(grid.occupied_mask(), pool, False, np.any)  # any mapped obstacle blocks a coarse cell
     costs = np.where(blocked, np.inf, 1.0)
     step = pool * grid.resolution
     total = np.ones(blocked.shape)
@@ -131,8 +121,7 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
             detour = np.where(np.isfinite(d_s) & np.isfinite(d_p), lead + d_p - d_s, 0.0)
         near = np.exp(-np.maximum(detour - params.slack_m, 0.0) / params.scale_m)
         total *= arrow.wrong_prob + (1.0 - arrow.wrong_prob) * near
-    rows, cols = grid.shape
-    fine = np.repeat(np.repeat(total, pool, axis=0), pool, axis=1)[:rows, :cols]
+    fine = unpool_cells(total, pool, grid.shape)
     return fine / float(fine.max())
 
 
@@ -144,15 +133,11 @@ def door_depth_weight(grid: OccupancyGrid, start_xy: np.ndarray, params: RoutePa
     pool = max(1, params.depth_pool)
     res = grid.resolution * pool
     clearance = ndimage.distance_transform_edt(~grid.occupied_mask()) * grid.resolution
-    rows, cols = clearance.shape
-    pr, pc = -(-rows // pool) * pool, -(-cols // pool) * pool
-    padded = np.zeros((pr, pc))
-    padded[:rows, :cols] = clearance
-    coarse = padded.reshape(pr // pool, pool, pc // pool, pool).min(axis=(1, 3))
+    coarse = pool_cells(clearance, pool, 0.0, np.min)  # off the grid counts as wall
     passable = coarse > params.robot_radius_m
     narrow = coarse < params.door_width_m / 2
     rc = np.clip(grid.world_to_cell(np.asarray(start_xy, dtype=float))[0] // pool, 0,
-                 [pr // pool - 1, pc // pool - 1])
+                 np.array(coarse.shape) - 1)
     if not passable[rc[0], rc[1]]:
         _, (ir, ic) = ndimage.distance_transform_edt(~passable, return_indices=True)
         rc = np.array([ir[rc[0], rc[1]], ic[rc[0], rc[1]]])
@@ -165,4 +150,4 @@ def door_depth_weight(grid: OccupancyGrid, start_xy: np.ndarray, params: RoutePa
     weight = params.room_weight ** np.clip(doors, 0.0, 6.0)
     reach = max(1, int(round(params.front_m / res)))
     front = ndimage.maximum_filter(weight, size=2 * reach + 1, mode="nearest")
-    return np.repeat(np.repeat(front, pool, axis=0), pool, axis=1)[:rows, :cols]
+    return unpool_cells(front, pool, grid.shape)

@@ -20,7 +20,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from skimage.graph import MCP_Geometric
 
-from sim.mapping.occupancy import OccupancyGrid
+from sim.mapping.occupancy import OccupancyGrid, pool_cells, unpool_cells
 from sim.navigation.belief import BeliefParams, cell_window, face_normals, in_cone, sight_clear
 from sim.navigation.planner import PlannerParams, cost_map
 
@@ -82,13 +82,9 @@ def travel_costs(grid: OccupancyGrid, robot_xy: np.ndarray, planner: PlannerPara
     if pool <= 1:
         cumulative, _ = MCP_Geometric(costs, fully_connected=True).find_costs([tuple(rc)])
         return cumulative * grid.resolution
-    pr, pc = -(-rows // pool) * pool, -(-cols // pool) * pool
-    padded = np.full((pr, pc), np.inf)
-    padded[:rows, :cols] = costs
-    coarse = padded.reshape(pr // pool, pool, pc // pool, pool).min(axis=(1, 3))
+    coarse = pool_cells(costs, pool, np.inf, np.min)
     cumulative, _ = MCP_Geometric(coarse, fully_connected=True).find_costs([tuple(rc // pool)])
-    fine = np.repeat(np.repeat(cumulative, pool, axis=0), pool, axis=1)[:rows, :cols]
-    return fine * grid.resolution * pool
+    return unpool_cells(cumulative, pool, grid.shape) * grid.resolution * pool
 
 
 @dataclass(frozen=True)

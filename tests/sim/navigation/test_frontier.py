@@ -60,17 +60,17 @@ def test_frontier_policy_finds_the_label_it_cannot_see_from_the_start(tiny_world
 
 
 def test_a_look_is_taken_again_only_after_the_robot_moves_or_the_map_grows():
-    from sim.navigation.frontier import look_if_moved
+    from sim.navigation.frontier import LookedAt
 
     grid = OccupancyGrid(OccupancyParams(resolution_m=0.1, bounds=(0.0, 10.0, 0.0, 10.0)))
     grid.log_odds[:] = -2.0  # all mapped free
     params = FrontierParams()
-    looked: list[np.ndarray] = []
-    covered = look_if_moved(grid, None, looked, np.array([2.0, 5.0]), params)
-    assert covered.any() and len(looked) == 1
+    looked = LookedAt()
+    covered = looked.update(grid, np.array([2.0, 5.0]), params)
+    assert covered.any() and looked.at is not None
     covered[:] = False  # a look now would mark cells again
-    assert not look_if_moved(grid, covered, looked, np.array([2.05, 5.0]), params).any()  # moved 5 cm: no look
-    assert look_if_moved(grid, covered, looked, np.array([2.5, 5.0]), params).any()  # moved 0.5 m: looks
+    assert not looked.update(grid, np.array([2.05, 5.0]), params).any()  # moved 5 cm: no look
+    assert looked.update(grid, np.array([2.5, 5.0]), params).any()  # moved 0.5 m: looks
     covered[:] = False
     grid.version += 1  # the map grew
-    assert look_if_moved(grid, covered, looked, np.array([2.5, 5.0]), params).any()
+    assert looked.update(grid, np.array([2.5, 5.0]), params).any()
