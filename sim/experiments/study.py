@@ -95,10 +95,16 @@ def run_spec(spec: TrialSpec) -> dict[str, Any]:
                            navigator=spec.navigator, params=spec.params, log=log)
         record = result.to_dict()
     except Exception as exc:  # a failed trial is data, not a crash of the study
-        record = {"goal": spec.goal, "seed": spec.seed, "perception": spec.perception, "success": False,
-                  "reason": f"error: {type(exc).__name__}: {exc}", "distance_m": None, "sim_s": 0.0,
-                  "wall_s": round(time.perf_counter() - began, 2), "traceback": traceback.format_exc()}
+        record = failed_record(spec, exc, began)
     return label_record(record, spec)
+
+
+def failed_record(spec: TrialSpec, exc: Exception, began: float) -> dict[str, Any]:
+    """The record of a trial that raised ``exc`` (call inside its ``except``): failed, the error as its reason,
+    the wall time since ``began`` (``time.perf_counter()``) and the traceback."""
+    return {"goal": spec.goal, "seed": spec.seed, "perception": spec.perception, "success": False,
+            "reason": f"error: {type(exc).__name__}: {exc}", "distance_m": None, "sim_s": 0.0,
+            "wall_s": round(time.perf_counter() - began, 2), "traceback": traceback.format_exc()}
 
 
 def shares_run(spec: TrialSpec) -> tuple[str, str, int, str, str] | None:
@@ -114,7 +120,7 @@ def run_unit(unit: tuple[TrialSpec, ...]) -> list[dict[str, Any]]:
     """Run the trials of ``unit`` (specs that share one run, or a single spec); one record per spec, in order.
 
     A shared run watches every goal of the unit until all are read or a cap is hit; each goal's record is the
-    run up to its label's first read (:meth:`sim.experiments.trial.Trial.result_for`). Never raises.
+    run up to its label's first read (:meth:`sim.experiments.trial.Trial.results`). Never raises.
     """
     if len(unit) == 1:
         return [run_spec(unit[0])]
@@ -127,12 +133,10 @@ def run_unit(unit: tuple[TrialSpec, ...]) -> list[dict[str, Any]]:
                    params=first.params, also=[s.goal for s in unit[1:]]) as trial:
             while not trial.done:
                 trial.step()
-            return [label_record(trial.result_for(spec.goal).to_dict(), spec) for spec in unit]
+            results = trial.results()
+            return [label_record(results[spec.goal].to_dict(), spec) for spec in unit]
     except Exception as exc:  # a failed run is data, not a crash of the study
-        return [label_record({"goal": spec.goal, "seed": spec.seed, "perception": spec.perception,
-                              "success": False, "reason": f"error: {type(exc).__name__}: {exc}",
-                              "distance_m": None, "sim_s": 0.0, "wall_s": round(time.perf_counter() - began, 2),
-                              "traceback": traceback.format_exc()}, spec) for spec in unit]
+        return [label_record(failed_record(spec, exc, began), spec) for spec in unit]
 
 
 def label_record(record: dict[str, Any], spec: TrialSpec) -> dict[str, Any]:

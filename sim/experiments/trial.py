@@ -176,7 +176,7 @@ class Trial:
     ``also`` names further goals to watch for a navigator that never reads a
     sign (``goal_blind``): its path does not depend on the goal, so one run
     that goes on until every watched label is read stands for one trial per
-    goal (:meth:`result_for`), exactly as separate runs with the same seed.
+    goal (:meth:`results`), exactly as separate runs with the same seed.
     """
 
     def __init__(self, world: World | str, goal: str, *, seed: int = 0, perception: str = "camera",
@@ -330,18 +330,22 @@ class Trial:
         )
 
 
-    def result_for(self, goal: str) -> TrialResult:
-        """The result a trial of ``goal`` alone (a watched goal) would have given: up to its label's first read,
-        or the whole run when it was never read."""
+    def results(self) -> dict[str, TrialResult]:
+        """Per watched goal, the result a trial of that goal alone would have given: the run up to its label's
+        first read, or the whole run when it was never read."""
         result = self.result()
-        reading = self.readings.get(goal)
-        if reading is None:
-            return replace(result, goal=goal, success=False,
-                           reason=self.reason if self.reason != "goal label read" else "not read")
-        trajectory = np.array([*self.trajectory[:reading.trajectory_len], (reading.t_s, *reading.pose)])
-        return replace(result, goal=goal, success=True, reason="goal label read", distance_m=reading.distance_m,
-                       sim_s=reading.t_s, wall_s=reading.wall_s, cpu_s=reading.cpu_s, trajectory=trajectory,
-                       frames=[f for f in result.frames if f.t_s <= reading.t_s])
+        out = {}
+        for goal in self.watched:
+            reading = self.readings.get(goal)
+            if reading is None:
+                out[goal] = replace(result, goal=goal, success=False)
+                continue
+            trajectory = np.array([*self.trajectory[:reading.trajectory_len], (reading.t_s, *reading.pose)])
+            out[goal] = replace(result, goal=goal, success=True, reason="goal label read",
+                                distance_m=reading.distance_m, sim_s=reading.t_s, wall_s=reading.wall_s,
+                                cpu_s=reading.cpu_s, trajectory=trajectory,
+                                frames=[f for f in result.frames if f.t_s <= reading.t_s])
+        return out
 
 
 def run_trial(world: World | str, goal: str, *, seed: int = 0, perception: str = "camera",

@@ -77,7 +77,7 @@ def test_one_goal_blind_run_stands_for_one_trial_per_goal(tmp_path):
                also=goals[1:]) as shared:
         while not shared.done:
             shared.step()
-        together = {goal: shared.result_for(goal) for goal in goals}
+        together = shared.results()
     assert together["Design Storeroom"].success and not together["Admin Office"].success
     for goal in goals:
         alone = run_trial(world, goal, seed=2, perception="geometric", navigator="frontier", params=params)
