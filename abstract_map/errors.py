@@ -121,6 +121,17 @@ def tag_id(where: str, value: Any, error: type[AbstractMapError] = AbstractMapEr
     return integer(where, value, low=0, high=TAG_ID_LIMIT, error=error)
 
 
+def point(where: str, values: Any, *, error: type[AbstractMapError] = AbstractMapError) -> tuple[float, float]:
+    """(x m, y m) with finite coordinates in range."""
+    try:
+        items = list(values)
+    except TypeError:
+        raise error(f"{where}: expected (x, y) in metres, got {show(values)}") from None
+    if len(items) != 2:
+        raise error(f"{where}: expected (x, y) in metres, got {show(values)}")
+    return coordinate(f"{where} x", items[0], error), coordinate(f"{where} y", items[1], error)
+
+
 def pose(where: str, values: Any, *, error: type[AbstractMapError] = AbstractMapError) -> tuple[float, float, float]:
     """(x m, y m, theta) with finite coordinates in range and a finite angle."""
     try:

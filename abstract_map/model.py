@@ -371,14 +371,7 @@ class AbstractMap:
         if xy is None:
             self.explored_centre = None
             return
-        try:
-            values = list(xy)
-        except TypeError:
-            raise ModelError(f"explored centre: expected (x, y) in metres, got {errors.show(xy)}") from None
-        if len(values) != 2:
-            raise ModelError(f"explored centre: expected (x, y) in metres, got {errors.show(xy)}")
-        self.explored_centre = np.array([errors.coordinate(f"explored centre {axis}", v, ModelError)
-                                         for axis, v in zip("xy", values)])
+        self.explored_centre = np.array(errors.point("explored centre", xy, error=ModelError))
 
     def settle(self) -> SettleReport:
         """Place new masses (Algorithm 2), then integrate until settled (Algorithm 1)."""
