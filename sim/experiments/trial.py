@@ -179,12 +179,12 @@ class Trial:
     goal (:meth:`results`), exactly as separate runs with the same seed.
     """
 
-    def __init__(self, world: World | str, goal: str, *, seed: int = 0, perception: str = "camera",
+    def __init__(self, world: World | str | os.PathLike[str], goal: str, *, seed: int = 0, perception: str = "camera",
                  navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
                  record: bool = False, also: Sequence[str] = ()) -> None:
         self.began = time.perf_counter()
         self.began_cpu = time.process_time()
-        self.world = load_world(world) if isinstance(world, str) else world
+        self.world = world if isinstance(world, World) else load_world(world)
         self.params = params = params or TrialParams()
         for name in (goal, *also):
             if name not in self.world.goals and not self.world.label_tags(name):
@@ -348,7 +348,7 @@ class Trial:
         return out
 
 
-def run_trial(world: World | str, goal: str, *, seed: int = 0, perception: str = "camera",
+def run_trial(world: World | str | os.PathLike[str], goal: str, *, seed: int = 0, perception: str = "camera",
               navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
               record: bool = False, log: str | os.PathLike[str] | None = None) -> TrialResult:
     """Run one trial of finding ``goal`` in ``world`` with the navigator driving, and report what happened.
