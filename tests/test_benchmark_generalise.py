@@ -9,11 +9,26 @@ from pathlib import Path
 BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks" / "run.py"
 
 
-def test_a_tiny_generalise_suite_runs_and_tabulates(tmp_path, capsys, monkeypatch):
+def _benchmarks(monkeypatch):
     spec = importlib.util.spec_from_file_location("benchmarks_run", BENCHMARKS)
     run = importlib.util.module_from_spec(spec)
     monkeypatch.setitem(sys.modules, "benchmarks_run", run)  # dataclasses look their module up there
     spec.loader.exec_module(run)
+    return run
+
+
+def test_a_shared_run_is_costed_once(monkeypatch):
+    run = _benchmarks(monkeypatch)
+    record = {"world": "w", "seed": 0, "perception": "geometric"}
+    frontier = [{**record, "navigator": "frontier", "cpu_s": c} for c in (4.0, 9.0, 9.0)]  # one run of 9 s
+    paper = [{**record, "navigator": "paper", "cpu_s": c} for c in (4.0, 9.0)]  # two runs
+    other_seed = [{**record, "seed": 1, "navigator": "frontier", "cpu_s": 2.0}]
+    assert run.run_cost(frontier + other_seed, "cpu_s") == 11.0
+    assert run.run_cost(paper, "cpu_s") == 13.0
+
+
+def test_a_tiny_generalise_suite_runs_and_tabulates(tmp_path, capsys, monkeypatch):
+    run = _benchmarks(monkeypatch)
     suite = run.GeneraliseSuite(buildings=1, camera_buildings=0, geometric=("frontier", "guided"), max_sim_s=10.0)
     run.bench_generalise(suite, workers=1, out=tmp_path / "gen")
     printed = capsys.readouterr().out
