@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pybullet as p
@@ -149,7 +150,7 @@ class Scene:
             return
         for start in range(0, len(corners), _MAX_MESH_QUADS):
             visual = self._visual(quad_mesh(corners[start:start + _MAX_MESH_QUADS]), rgba)
-            body = p.createMultiBody(0, -1, visual, physicsClientId=self.client)
+            body = _visual_body(visual, physicsClientId=self.client)
             self._decor_ids.append(body)
             self._rgba[body] = rgba
             self._shown[body] = True
@@ -216,7 +217,7 @@ class Scene:
         self.wall_collision_ids.append(body)
 
     def _add_wall_tile(self, mesh: Mesh) -> int:
-        body = p.createMultiBody(0, -1, self._visual(mesh, self.params.wall_rgba), physicsClientId=self.client)
+        body = _visual_body(self._visual(mesh, self.params.wall_rgba), physicsClientId=self.client)
         self.wall_body_ids.append(body)
         self._rgba[body] = self.params.wall_rgba
         self._shown[body] = True
@@ -323,7 +324,7 @@ class Scene:
             if not self.params.visuals:
                 continue
             orientation = p.getQuaternionFromEuler([0, 0, pose.theta])
-            body = p.createMultiBody(0, -1, self.tag_visual_shape(), basePosition=[pose.x, pose.y, pose.z],
+            body = _visual_body(self.tag_visual_shape(), basePosition=[pose.x, pose.y, pose.z],
                                      baseOrientation=orientation, physicsClientId=cid)
             p.changeVisualShape(body, -1, textureUniqueId=self.texture(tag.id), rgbaColor=[1, 1, 1, 1],
                                 physicsClientId=cid)
@@ -427,6 +428,12 @@ class Scene:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _visual_body(visual: int, **kwargs: Any) -> int:
+    """A static body that is only drawn: a rigid body (maximal coordinates), which pybullet's step skips, unlike
+    the multibody it makes by default (~500 of those doubled a camera trial's physics step)."""
+    return p.createMultiBody(0, -1, visual, useMaximalCoordinates=True, **kwargs)
 
 
 def build_scene(world: World, *, gui: bool = False, params: SceneParams | None = None) -> Scene:
