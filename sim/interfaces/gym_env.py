@@ -43,6 +43,7 @@ from sim.world.data import World, load_world
 from sim.world.robot import RobotParams
 
 GENERATED = "generated"
+GYM_CONTROL_HZ = 10.0  # Hz: one step is 0.1 s simulated, the rate agents commonly act at (trials run at 5 Hz)
 
 
 def _twist(action: np.ndarray, robot: RobotParams) -> tuple[float, float]:
@@ -82,7 +83,7 @@ class FindPlaceEnv(gymnasium.Env):
             raise ValueError(f"render_mode {render_mode!r}: expected one of {self.metadata['render_modes']} or None")
         if tag_slots < 1:
             raise ValueError(f"tag_slots must be at least 1, got {tag_slots}")
-        base = params or TrialParams()
+        base = params or replace(TrialParams(), control_hz=GYM_CONTROL_HZ)
         self.params = replace(base, mapping_hz=base.control_hz)  # a fresh scan in every observation
         self.generator = dict(generator or {})
         self._generated: Path | None = None
