@@ -27,7 +27,7 @@ import pybullet as p
 
 from sim.perception.sighting import Sighting
 from sim.world.robot import Robot
-from sim.world.scene import Scene
+from sim.world.scene import Scene, TagPose
 from sim.world.visibility import readable
 
 _REFINEMENT = MappingProxyType({
@@ -62,6 +62,9 @@ class CameraParams:
     visibility_rays: int = 360  # horizontal rays choosing which wall tiles to draw
     corner_refinement: str = "subpix"  # one of "none", "subpix", "contour", "apriltag"
     skip_empty_views: bool = True  # render only views that can contain a tag (same result, faster)
+    # deg beyond the reading cone within which a tag is still drawn. Of 1,120 detections (zoo Lion, a generated
+    # office) those the cone passed were at most 45.3 deg off in truth, and no facing erred by more than 11.3 deg.
+    render_cone_margin_deg: float = 15.0
 
     @property
     def hfov(self) -> float:
@@ -202,28 +205,59 @@ class CameraPerception:
     def views_to_render(self, x: float, y: float, yaw: float) -> list[int]:
         """Indices of the views that can show a tag's face from (x, y) m with view 0 along ``yaw`` rad.
 
-        Tags beyond ``max_range_m + render_margin_m`` are not drawn at all and a
-        tag seen from behind shows its blank back, so a view without any other
-        tag in its field of view yields no detection: skipping it changes
-        nothing but the time a sweep takes.
+        Tags beyond ``max_range_m + render_margin_m`` are not drawn at all, a
+        tag seen from behind shows its blank back, a tag seen more obliquely
+        than the reading cone plus ``render_cone_margin_deg`` is never read
+        (its detection's facing would have to err by that much), and a tag whose black square
+        has both side edges behind walls cannot be decoded (walls are extruded,
+        so what hides an edge at the camera's height hides it at every height).
+        A view without any other tag in its field of view yields no detection:
+        skipping it changes nothing but the time a sweep takes.
         """
         prm = self.params
         radius = prm.max_range_m + prm.render_margin_m
         half_size = self.scene.world.tag_size * (8 + 2 * self.scene.params.tag_margin_cells) / 16.0
-        views: set[int] = set()
+        cone_cos = math.cos(math.radians(min(90.0, prm.cone_half_angle_deg + prm.render_cone_margin_deg)))
+        near = []
         for pose in self.scene.tag_poses.values():
             dx, dy = pose.x - x, pose.y - y
             distance = math.hypot(dx, dy)
             if distance > radius or distance < 1e-6:
                 continue
-            if dx * math.cos(pose.theta) + dy * math.sin(pose.theta) >= 0:
-                continue  # the camera is behind the tag's face
+            facing = -(dx * math.cos(pose.theta) + dy * math.sin(pose.theta)) / distance  # cos of the angle off
+            if facing <= cone_cos:
+                continue  # behind the face, or too oblique for any reading to pass the cone
+            near.append((pose, dx, dy, distance))
+        views: set[int] = set()
+        hidden_edges = self._edges_hidden(x, y, [pose for pose, *_ in near])
+        for (_, dx, dy, distance), hidden in zip(near, hidden_edges, strict=True):
+            if hidden:
+                continue
             bearing = math.atan2(dy, dx)
             reach = prm.hfov / 2.0 + math.atan2(half_size, distance)
             for k in range(prm.n_views):
                 if abs(math.remainder(bearing - yaw - k * math.tau / prm.n_views, math.tau)) <= reach:
                     views.add(k)
         return sorted(views)
+
+    def _edges_hidden(self, x: float, y: float, poses: list[TagPose]) -> list[bool]:
+        """Whether walls hide both side edges of each tag's black square from (x, y) m (rays at one height).
+
+        The rays end 1 cm in front of the face and 1 cm inside the square's edges, so that neither the tag's own
+        wall nor a wall meeting it at a corner counts as hiding an edge that can be seen.
+        """
+        if not poses:
+            return []
+        inset = self.scene.world.tag_size / 2.0 - 0.01
+        origins, ends = [], []
+        for pose in poses:  # rays at the tag's centre height, below the walls' tops
+            c, s = math.cos(pose.theta), math.sin(pose.theta)
+            front_x, front_y = pose.x + 0.01 * c, pose.y + 0.01 * s
+            origins += [(x, y, pose.z)] * 2
+            ends += [(front_x - inset * s, front_y + inset * c, pose.z), (front_x + inset * s, front_y - inset * c,
+                                                                         pose.z)]
+        fractions = self.scene.ray_fractions(np.array(origins), np.array(ends))
+        return (fractions.reshape(-1, 2) < 1.0).all(axis=1).tolist()
 
     def render(self, x: float, y: float, z: float, yaw: float,
                views: list[int] | None = None) -> dict[int, np.ndarray]:

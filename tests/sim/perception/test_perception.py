@@ -35,6 +35,8 @@ CASES = [
                                      6.0, 2.5), 0, True),
     ("behind a free-standing tag", (3.0, 4.0, math.pi / 2), 1, False),
     ("wall tag from the wrong side", (4.5, 0.8, 0.0), 3, False),
+    ("oblique 70 deg at 2 m", facing(6.0 - 2 * math.cos(math.radians(70)), 2.5 + 2 * math.sin(math.radians(70)),
+                                     6.0, 2.5), 0, False),
     ("past 4 m", (1.0, 2.5, 0.0), 0, False),
     ("through a wall", (4.5, 2.5, 0.0), 2, False),
 ]
@@ -115,6 +117,14 @@ def test_skipping_empty_views_changes_nothing(tiny_scene, robot):
     fast = CameraPerception(tiny_scene)
     for _, pose, _, _ in CASES:
         assert _observe(tiny_scene, robot, full, pose) == _observe(tiny_scene, robot, fast, pose)
+
+
+def test_views_skip_tags_whose_edges_walls_hide(tiny_scene):
+    from sim.perception import CameraPerception
+
+    camera = CameraPerception(tiny_scene)
+    poses = tiny_scene.tag_poses
+    assert camera._edges_hidden(4.5, 2.5, [poses[2], poses[0]]) == [True, False]  # tag 2 is through a wall
 
 
 def test_camera_ignores_tags_of_other_worlds(tiny_scene, robot, perceptions):
