@@ -37,7 +37,7 @@ from sim.navigation.frontier import FrontierParams, LookedAt, nearest_frontier, 
 from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
 from sim.navigation.planner import Plan, PlannerParams
 from sim.navigation.replanner import Replanner, ReplanParams
-from sim.navigation.routes import Arrow, GuideParams, RouteParams, door_depth_weight, route_likelihood
+from sim.navigation.routes import Arrow, GuideParams, PathSearches, RouteParams, door_depth_weight, route_likelihood
 from sim.navigation.targeting import Target, TargetParams, choose_target
 from sim.navigation.viewpoints import ViewpointParams, Viewpoints, score_viewpoints, travel_costs
 from sim.perception.sighting import Sighting
@@ -134,6 +134,7 @@ class AbstractMapPolicy:
         self.evidence_key: tuple[Arrow, ...] = ()
         self.evidence_at = -float("inf")
         self.evidence_count = 0  # refreshes of the evidence so far (what was worked out from it knows its age)
+        self.searches = PathSearches()  # the evidence's path searches, run again only on a changed map
         self.now = 0.0  # s, simulated time of the latest command
 
     @property
@@ -184,8 +185,8 @@ class AbstractMapPolicy:
         key = tuple(arrows)
         if self.evidence is None or key != self.evidence_key or self.now - self.evidence_at >= \
                 self.params.routes.evidence_every_s:
-            self.depth = door_depth_weight(grid, self.start[:2], self.params.routes)
-            likelihood = route_likelihood(grid, arrows, self.params.routes)
+            self.depth = door_depth_weight(grid, self.start[:2], self.params.routes, self.searches)
+            likelihood = route_likelihood(grid, arrows, self.params.routes, self.searches)
             self.evidence = self.depth if likelihood is None else self.depth * likelihood
             self.evidence_key, self.evidence_at = key, self.now
             self.evidence_count += 1
