@@ -54,24 +54,37 @@ class Frontiers:
     distance_m: np.ndarray  # (rows, cols) float: path length from the robot through passable seen space; inf
 
 
-def look(grid: OccupancyGrid, covered: np.ndarray, robot_xy: np.ndarray, params: FrontierParams) -> None:
+def look(grid: OccupancyGrid, covered: np.ndarray, robot_xy: np.ndarray, params: FrontierParams,
+         rays: np.ndarray | None = None) -> None:
     """Mark in ``covered`` (bool, the grid's shape) the known cells within ``look_radius_m`` of ``robot_xy`` (m)
-    in line of sight over the grid (a ray stops at the first occupied cell, which it marks)."""
+    in line of sight over the grid (a ray stops at the first occupied cell, which it marks); ``rays``:
+    :func:`look_rays` for this grid when already at hand."""
+    offsets = look_rays(grid, params) if rays is None else rays
+    x = robot_xy[0] + offsets[0]
+    y = robot_xy[1] + offsets[1]
+    rows, cols = grid.shape
+    x0, y0 = grid.origin
+    # world_to_cell, on the (rays, samples) arrays as they are
+    col = np.floor((x - x0) / grid.resolution).astype(int)
+    row = rows - 1 - np.floor((y - y0) / grid.resolution).astype(int)
+    inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
+    values = np.zeros(x.shape, dtype=np.float32)  # outside the grid: unknown
+    values[inside] = grid.log_odds[row[inside], col[inside]]
+    occupied = values > grid.params.occupied_threshold
+    known = occupied | (values < grid.params.free_threshold)
+    # visible: no occupied sample before this one along the ray (the first occupied one is visible)
+    blocked_before = np.cumsum(occupied, axis=1) - occupied > 0
+    mark = ~blocked_before & inside & known
+    covered[row[mark], col[mark]] = True
+
+
+def look_rays(grid: OccupancyGrid, params: FrontierParams) -> np.ndarray:
+    """(2, rays, samples): the x and y offsets (m) from the robot of the samples :func:`look` reads, half a cell
+    apart along ``look_rays`` rays out to ``look_radius_m``."""
     step = 0.5 * grid.resolution
     d = np.arange(1, int(np.ceil(params.look_radius_m / step)) + 1) * step
     angles = np.linspace(-np.pi, np.pi, params.look_rays, endpoint=False)
-    x = robot_xy[0] + np.cos(angles)[:, None] * d[None, :]
-    y = robot_xy[1] + np.sin(angles)[:, None] * d[None, :]
-    rc = grid.world_to_cell(np.stack([x.ravel(), y.ravel()], axis=1))
-    inside = grid.in_bounds(rc)
-    values = np.zeros(len(rc), dtype=np.float32)  # outside the grid: unknown
-    values[inside] = grid.log_odds[rc[inside, 0], rc[inside, 1]]
-    occupied = (values > grid.params.occupied_threshold).reshape(x.shape)
-    known = (values > grid.params.occupied_threshold) | (values < grid.params.free_threshold)
-    # visible: no occupied sample before this one along the ray (the first occupied one is visible)
-    blocked_before = np.cumsum(occupied, axis=1) - occupied > 0
-    mark = (~blocked_before).ravel() & inside & known
-    covered[rc[mark, 0], rc[mark, 1]] = True
+    return np.stack([np.cos(angles)[:, None] * d[None, :], np.sin(angles)[:, None] * d[None, :]])
 
 
 @dataclass
@@ -80,6 +93,7 @@ class LookedAt:
 
     covered: np.ndarray | None = None  # bool, the grid's shape
     at: tuple[float, float, int] | None = None  # x m, y m and the grid's version at the latest look
+    rays: np.ndarray | None = None  # :func:`look_rays` for the grid, worked out once
 
     def update(self, grid: OccupancyGrid, robot_xy: np.ndarray, params: FrontierParams) -> np.ndarray:
         """:attr:`covered` after a look from ``robot_xy`` (m), taken only when the robot has moved
@@ -87,10 +101,11 @@ class LookedAt:
         the spot adds nothing. A grid of another shape starts the record afresh."""
         if self.covered is None or self.covered.shape != grid.shape:
             self.covered, self.at = np.zeros(grid.shape, dtype=bool), None
+            self.rays = look_rays(grid, params)
         if self.at is not None and self.at[2] == grid.version and \
                 float(np.hypot(robot_xy[0] - self.at[0], robot_xy[1] - self.at[1])) < params.look_every_m:
             return self.covered
-        look(grid, self.covered, robot_xy, params)
+        look(grid, self.covered, robot_xy, params, self.rays)
         self.at = (float(robot_xy[0]), float(robot_xy[1]), grid.version)
         return self.covered
 
