@@ -128,3 +128,18 @@ def test_frontier_path_lengths_are_the_whole_grids():
     finite = np.isfinite(whole)
     assert finite.sum() > 1000 and np.array_equal(np.isfinite(found.distance_m), finite)
     assert np.max(np.abs(found.distance_m[finite] - whole[finite] * grid.resolution)) < 1e-9
+
+
+def test_a_look_stops_at_walls_and_kept_rays_mark_the_same_cells():
+    from sim.navigation.frontier import look, look_rays
+
+    grid = room_grid()  # a wall at x = 3 m from y = 0 to 5 m
+    robot = np.array([2.0, 2.0])
+    fresh, kept = np.zeros(grid.shape, dtype=bool), np.zeros(grid.shape, dtype=bool)
+    look(grid, fresh, robot, PARAMS)
+    look(grid, kept, robot, PARAMS, look_rays(grid, PARAMS))
+    assert np.array_equal(fresh, kept)
+    seen = lambda x, y: bool(fresh[tuple(grid.world_to_cell(np.array([x, y]))[0])])  # noqa: E731
+    assert seen(1.0, 2.0) and seen(2.85, 2.0)  # free, and the wall's first cell
+    assert not seen(3.05, 2.0) and not seen(3.5, 2.0)  # in and behind the wall
+    assert not seen(1.0, 5.4)  # free and in line of sight, but 3.5 m away: beyond look_radius_m
