@@ -147,6 +147,7 @@ def _margin_cells(grid: OccupancyGrid, params: FrontierParams) -> int:
 
 
 def _reach_cells(grid: OccupancyGrid, params: FrontierParams) -> int:
+    """``reach_m`` in cells of ``grid`` (at least one)."""
     return max(1, int(round(params.reach_m / grid.resolution)))
 
 
