@@ -21,7 +21,8 @@ from scipy import ndimage
 from skimage.graph import MCP_Geometric
 
 from sim.mapping.occupancy import OccupancyGrid
-from sim.navigation.targeting import clearance_m, seen_passable
+from sim.navigation.planner import distance_to_occupied
+from sim.navigation.targeting import filled_free, seen_passable
 
 _EIGHT = np.ones((3, 3), dtype=bool)
 
@@ -53,24 +54,37 @@ class Frontiers:
     distance_m: np.ndarray  # (rows, cols) float: path length from the robot through passable seen space; inf
 
 
-def look(grid: OccupancyGrid, covered: np.ndarray, robot_xy: np.ndarray, params: FrontierParams) -> None:
+def look(grid: OccupancyGrid, covered: np.ndarray, robot_xy: np.ndarray, params: FrontierParams,
+         rays: np.ndarray | None = None) -> None:
     """Mark in ``covered`` (bool, the grid's shape) the known cells within ``look_radius_m`` of ``robot_xy`` (m)
-    in line of sight over the grid (a ray stops at the first occupied cell, which it marks)."""
+    in line of sight over the grid (a ray stops at the first occupied cell, which it marks); ``rays``:
+    :func:`look_rays` for this grid when already at hand."""
+    offsets = look_rays(grid, params) if rays is None else rays
+    x = robot_xy[0] + offsets[0]
+    y = robot_xy[1] + offsets[1]
+    rows, cols = grid.shape
+    x0, y0 = grid.origin
+    # world_to_cell, on the (rays, samples) arrays as they are
+    col = np.floor((x - x0) / grid.resolution).astype(int)
+    row = rows - 1 - np.floor((y - y0) / grid.resolution).astype(int)
+    inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
+    values = np.zeros(x.shape, dtype=np.float32)  # outside the grid: unknown
+    values[inside] = grid.log_odds[row[inside], col[inside]]
+    occupied = values > grid.params.occupied_threshold
+    known = occupied | (values < grid.params.free_threshold)
+    # visible: no occupied sample before this one along the ray (the first occupied one is visible)
+    blocked_before = np.cumsum(occupied, axis=1) - occupied > 0
+    mark = ~blocked_before & inside & known
+    covered[row[mark], col[mark]] = True
+
+
+def look_rays(grid: OccupancyGrid, params: FrontierParams) -> np.ndarray:
+    """(2, rays, samples): the x and y offsets (m) from the robot of the samples :func:`look` reads, half a cell
+    apart along ``look_rays`` rays out to ``look_radius_m``."""
     step = 0.5 * grid.resolution
     d = np.arange(1, int(np.ceil(params.look_radius_m / step)) + 1) * step
     angles = np.linspace(-np.pi, np.pi, params.look_rays, endpoint=False)
-    x = robot_xy[0] + np.cos(angles)[:, None] * d[None, :]
-    y = robot_xy[1] + np.sin(angles)[:, None] * d[None, :]
-    rc = grid.world_to_cell(np.stack([x.ravel(), y.ravel()], axis=1))
-    inside = grid.in_bounds(rc)
-    values = np.zeros(len(rc), dtype=np.float32)  # outside the grid: unknown
-    values[inside] = grid.log_odds[rc[inside, 0], rc[inside, 1]]
-    occupied = (values > grid.params.occupied_threshold).reshape(x.shape)
-    known = (values > grid.params.occupied_threshold) | (values < grid.params.free_threshold)
-    # visible: no occupied sample before this one along the ray (the first occupied one is visible)
-    blocked_before = np.cumsum(occupied, axis=1) - occupied > 0
-    mark = (~blocked_before).ravel() & inside & known
-    covered[rc[mark, 0], rc[mark, 1]] = True
+    return np.stack([np.cos(angles)[:, None] * d[None, :], np.sin(angles)[:, None] * d[None, :]])
 
 
 @dataclass
@@ -79,6 +93,7 @@ class LookedAt:
 
     covered: np.ndarray | None = None  # bool, the grid's shape
     at: tuple[float, float, int] | None = None  # x m, y m and the grid's version at the latest look
+    rays: np.ndarray | None = None  # :func:`look_rays` for the grid, worked out once
 
     def update(self, grid: OccupancyGrid, robot_xy: np.ndarray, params: FrontierParams) -> np.ndarray:
         """:attr:`covered` after a look from ``robot_xy`` (m), taken only when the robot has moved
@@ -86,27 +101,69 @@ class LookedAt:
         the spot adds nothing. A grid of another shape starts the record afresh."""
         if self.covered is None or self.covered.shape != grid.shape:
             self.covered, self.at = np.zeros(grid.shape, dtype=bool), None
+            self.rays = look_rays(grid, params)
         if self.at is not None and self.at[2] == grid.version and \
                 float(np.hypot(robot_xy[0] - self.at[0], robot_xy[1] - self.at[1])) < params.look_every_m:
             return self.covered
-        look(grid, self.covered, robot_xy, params)
+        look(grid, self.covered, robot_xy, params, self.rays)
         self.at = (float(robot_xy[0]), float(robot_xy[1]), grid.version)
         return self.covered
 
 
 def frontier_mask(grid: OccupancyGrid, robot_radius_m: float, params: FrontierParams,
                   covered: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """(frontier cells, passable cells), both bool (rows, cols); ``covered``: cells looked at (see :func:`look`)."""
-    clearance = clearance_m(grid)
-    passable = seen_passable(grid, clearance, robot_radius_m, params.fill_holes_cells)
-    free = grid.free_mask()
-    if params.fill_holes_cells > 0:
-        free = free | ndimage.binary_closing(free, iterations=params.fill_holes_cells)  # fills; never erodes
-    unknown = ~free & ~grid.occupied_mask()
+    """(frontier cells, passable cells), both bool (rows, cols); ``covered``: cells looked at (see :func:`look`).
+
+    Worked out on the known cells' bounding box with a margin (:func:`known_box`): both masks are empty
+    farther out, and every step within looks no farther than the margin (the clearance is wanted only up to
+    the robot's radius), so the answer is the whole grid's."""
+    frontier, passable = np.zeros(grid.shape, dtype=bool), np.zeros(grid.shape, dtype=bool)
+    box = known_box(grid, _margin_cells(grid, params))
+    if box is None:
+        return frontier, passable
+    rows, cols = box
+    window = _window(grid, rows.start, rows.stop, cols.start, cols.stop)
+    frontier[box], passable[box] = _frontier_mask(window, robot_radius_m, params,
+                                                  None if covered is None else covered[box])
+    return frontier, passable
+
+
+def known_box(grid: OccupancyGrid, margin_cells: int) -> tuple[slice, slice] | None:
+    """(rows, cols) slices of the bounding box of the grid's known cells grown by ``margin_cells`` (cut to the
+    grid), or None when no cell is known."""
+    known = (grid.log_odds > grid.params.occupied_threshold) | (grid.log_odds < grid.params.free_threshold)
+    rows, cols = np.flatnonzero(known.any(axis=1)), np.flatnonzero(known.any(axis=0))
+    if rows.size == 0:
+        return None
+    n_rows, n_cols = grid.shape
+    return (slice(max(0, rows[0] - margin_cells), min(n_rows, rows[-1] + margin_cells + 1)),
+            slice(max(0, cols[0] - margin_cells), min(n_cols, cols[-1] + margin_cells + 1)))
+
+
+def _margin_cells(grid: OccupancyGrid, params: FrontierParams) -> int:
+    """Cells around the known ones that :func:`frontier_mask` must see: the closing's reach (filled space lies
+    within the known cells' box) and the reach to unseen space, plus one."""
+    return max(params.fill_holes_cells, _reach_cells(grid, params)) + 1
+
+
+def _reach_cells(grid: OccupancyGrid, params: FrontierParams) -> int:
+    """``reach_m`` in cells of ``grid`` (at least one)."""
+    return max(1, int(round(params.reach_m / grid.resolution)))
+
+
+def _frontier_mask(grid: OccupancyGrid, robot_radius_m: float, params: FrontierParams,
+                   covered: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`frontier_mask` over every cell of ``grid``."""
+    filled = filled_free(grid, params.fill_holes_cells)
+    # Clearance (m) exact up to just past the robot's radius, inf beyond: all that passability asks of it.
+    cap = int(np.ceil(robot_radius_m / grid.resolution)) + 1
+    clearance = distance_to_occupied(grid.occupied_mask(), cap).astype(float) * grid.resolution
+    passable = seen_passable(grid, clearance, robot_radius_m, params.fill_holes_cells, filled)
+    occupied = grid.occupied_mask()
+    unknown = ~(grid.free_mask() | filled) & ~occupied  # the closing fills; never erodes
     if covered is not None:
-        unknown |= ~covered & ~grid.occupied_mask()
-    reach = max(1, int(round(params.reach_m / grid.resolution)))
-    near_unknown = ndimage.binary_dilation(unknown, structure=_EIGHT, iterations=reach)
+        unknown |= ~covered & ~occupied
+    near_unknown = ndimage.binary_dilation(unknown, structure=_EIGHT, iterations=_reach_cells(grid, params))
     frontier = passable & near_unknown
     labels, count = ndimage.label(frontier, structure=_EIGHT)
     if count:
@@ -123,7 +180,8 @@ def frontier_mask(grid: OccupancyGrid, robot_radius_m: float, params: FrontierPa
 
 def find_frontiers(grid: OccupancyGrid, robot_xy: np.ndarray, robot_radius_m: float,
                    params: FrontierParams, covered: np.ndarray | None = None) -> Frontiers:
-    """Frontier cells and path distances from ``robot_xy`` (m) through passable seen space."""
+    """Frontier cells and path distances from ``robot_xy`` (m) through passable seen space (searched on the
+    passable cells' bounding box: paths never leave it)."""
     frontier, passable = frontier_mask(grid, robot_radius_m, params, covered)
     distance = np.full(grid.shape, np.inf)
     start = grid.world_to_cell(np.asarray(robot_xy, dtype=float))[0]
@@ -136,10 +194,13 @@ def find_frontiers(grid: OccupancyGrid, robot_xy: np.ndarray, robot_radius_m: fl
     if cells.size == 0:
         return Frontiers(frontier, distance)
     nearest = cells[np.argmin(np.hypot(*(cells + [r0, c0] - start).T))] + [r0, c0]
-    costs = np.where(passable, 1.0, np.inf)
-    cumulative, _ = MCP_Geometric(costs, fully_connected=True).find_costs([tuple(nearest)])
+    rows, cols = np.flatnonzero(passable.any(axis=1)), np.flatnonzero(passable.any(axis=0))
+    box = (slice(rows[0], rows[-1] + 1), slice(cols[0], cols[-1] + 1))
+    costs = np.where(passable[box], 1.0, np.inf)
+    seed = (int(nearest[0] - rows[0]), int(nearest[1] - cols[0]))
+    cumulative, _ = MCP_Geometric(costs, fully_connected=True).find_costs([seed])
     offset = float(np.hypot(*(nearest - start))) * grid.resolution
-    distance = np.where(np.isfinite(cumulative), cumulative * grid.resolution + offset, np.inf)
+    distance[box] = np.where(np.isfinite(cumulative), cumulative * grid.resolution + offset, np.inf)
     return Frontiers(frontier, distance)
 
 

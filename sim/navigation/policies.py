@@ -37,7 +37,7 @@ from sim.navigation.frontier import FrontierParams, LookedAt, nearest_frontier, 
 from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
 from sim.navigation.planner import Plan, PlannerParams
 from sim.navigation.replanner import Replanner, ReplanParams
-from sim.navigation.routes import Arrow, GuideParams, RouteParams, door_depth_weight, route_likelihood
+from sim.navigation.routes import Arrow, GuideParams, PathSearches, RouteParams, door_depth_weight, route_likelihood
 from sim.navigation.targeting import Target, TargetParams, choose_target
 from sim.navigation.viewpoints import ViewpointParams, Viewpoints, score_viewpoints, travel_costs
 from sim.perception.sighting import Sighting
@@ -133,6 +133,8 @@ class AbstractMapPolicy:
         self.evidence: np.ndarray | None = None  # depth x route likelihood, per grid cell
         self.evidence_key: tuple[Arrow, ...] = ()
         self.evidence_at = -float("inf")
+        self.evidence_count = 0  # refreshes of the evidence so far (what was worked out from it knows its age)
+        self.searches = PathSearches()  # the evidence's path searches, run again only on a changed map
         self.now = 0.0  # s, simulated time of the latest command
 
     @property
@@ -183,10 +185,11 @@ class AbstractMapPolicy:
         key = tuple(arrows)
         if self.evidence is None or key != self.evidence_key or self.now - self.evidence_at >= \
                 self.params.routes.evidence_every_s:
-            self.depth = door_depth_weight(grid, self.start[:2], self.params.routes)
-            likelihood = route_likelihood(grid, arrows, self.params.routes)
+            self.depth = door_depth_weight(grid, self.start[:2], self.params.routes, self.searches)
+            likelihood = route_likelihood(grid, arrows, self.params.routes, self.searches)
             self.evidence = self.depth if likelihood is None else self.depth * likelihood
             self.evidence_key, self.evidence_at = key, self.now
+            self.evidence_count += 1
         return self.evidence
 
 
@@ -405,20 +408,28 @@ class GuidedPolicy(AbstractMapPolicy):
         super().__init__(world, goal, start, params)
         frontier = replace(FrontierParams(), min_distance_m=params.guide.min_target_m)
         self.search = FrontierSearch(params, self.drive, frontier, params.guide.rechoose_s)
+        self.penalty: tuple[tuple, np.ndarray] | None = None  # the latest penalty and what it was worked out from
 
     def forget_target(self) -> None:
         self.search.target = None
 
     def _penalty(self, grid: OccupancyGrid) -> np.ndarray:
-        """Per grid cell, the guide's penalty (m): ``penalty_m`` x -ln(evidence / its peak)."""
+        """Per grid cell, the guide's penalty (m): ``penalty_m`` x -ln(evidence / its peak); worked out again only
+        when the imagined goal, its spread or the evidence changed."""
         bp, gp = self.params.belief, self.params.guide
         goal, sigma = self.goal_prior()
+        layer = self._evidence(grid)
+        key = (float(goal[0]), float(goal[1]), float(sigma), self.evidence_count, grid.shape)
+        if self.penalty is not None and self.penalty[0] == key:
+            return self.penalty[1]
         x, y = grid.cell_axes()
         d2 = (y[:, None] - goal[1]) ** 2 + (x[None, :] - goal[0]) ** 2
         wide = bp.tail_scale * sigma
         prior = (1 - bp.tail_weight) * np.exp(-0.5 * d2 / sigma ** 2) + bp.tail_weight * np.exp(-0.5 * d2 / wide ** 2)
-        evidence = prior * self._evidence(grid)
-        return gp.penalty_m * -np.log(np.maximum(evidence / max(float(evidence.max()), 1e-300), gp.floor))
+        evidence = prior * layer
+        penalty = gp.penalty_m * -np.log(np.maximum(evidence / max(float(evidence.max()), 1e-300), gp.floor))
+        self.penalty = (key, penalty)
+        return penalty
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:

@@ -32,13 +32,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import ndimage
 from skimage.graph import MCP_Geometric
 
 from sim.mapping.occupancy import OccupancyGrid, pool_cells, unpool_cells
+from sim.navigation.planner import distance_to_occupied
 
 
 @dataclass(frozen=True)
@@ -84,6 +85,26 @@ class Arrow:
     wrong_prob: float  # chance the arrow does not lead towards the goal
 
 
+@dataclass
+class PathSearches:
+    """Path-length searches kept between calls: a search from a cell over a cost grid is run again only when
+    that grid changed (walls are mapped slowly, so the coarse grids often stay the same for a while)."""
+
+    costs: dict[str, np.ndarray] = field(default_factory=dict)  # the cost grid of each kind of search
+    found: dict[tuple[str, tuple[int, int]], np.ndarray] = field(default_factory=dict)  # (kind, start) -> lengths
+
+    def lengths(self, kind: str, costs: np.ndarray, start: tuple[int, int]) -> np.ndarray:
+        """Cumulative cost (in cells of ``costs``) from ``start`` to every cell of ``costs`` (inf: cut off), by
+        scikit-image's minimum-cost path, 8-connected."""
+        known = self.costs.get(kind)
+        if known is None or known.shape != costs.shape or not np.array_equal(known, costs):
+            self.costs[kind] = costs.copy()
+            self.found = {key: value for key, value in self.found.items() if key[0] != kind}
+        if (kind, start) not in self.found:
+            self.found[kind, start] = MCP_Geometric(costs, fully_connected=True).find_costs([start])[0]
+        return self.found[kind, start]
+
+
 def _cell(grid: OccupancyGrid, pool: int, blocked: np.ndarray, xy: np.ndarray) -> tuple[int, int] | None:
     """The open coarse cell nearest to ``xy`` (m), or None when the grid has none."""
     rc = grid.world_to_cell(xy)[0] // pool
@@ -96,9 +117,11 @@ def _cell(grid: OccupancyGrid, pool: int, blocked: np.ndarray, xy: np.ndarray) -
     return None if blocked[r, c] else (r, c)
 
 
-def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: RouteParams = RouteParams()
-                     ) -> np.ndarray | None:
-    """The product over ``arrows`` of each one's likelihood, per cell of ``grid`` (float, max 1); None if none."""
+def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: RouteParams = RouteParams(),
+                     searches: PathSearches | None = None) -> np.ndarray | None:
+    """The product over ``arrows`` of each one's likelihood, per cell of ``grid`` (float, max 1); None if none.
+    ``searches``: path searches kept from earlier calls (the same answer, sooner)."""
+    searches = PathSearches() if searches is None else searches
     arrows = list(arrows)
     if not arrows:
         return None
@@ -114,8 +137,8 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
         s, p = _cell(grid, pool, blocked, stand), _cell(grid, pool, blocked, probe)
         if s is None or p is None or s == p:
             continue
-        d_s = MCP_Geometric(costs, fully_connected=True).find_costs([s])[0] * step
-        d_p = MCP_Geometric(costs, fully_connected=True).find_costs([p])[0] * step
+        d_s = searches.lengths("route", costs, s) * step
+        d_p = searches.lengths("route", costs, p) * step
         lead = float(np.hypot(p[0] - s[0], p[1] - s[1])) * step
         with np.errstate(invalid="ignore"):
             detour = np.where(np.isfinite(d_s) & np.isfinite(d_p), lead + d_p - d_s, 0.0)
@@ -125,14 +148,19 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
     return fine / float(fine.max())
 
 
-def door_depth_weight(grid: OccupancyGrid, start_xy: np.ndarray, params: RouteParams = RouteParams()) -> np.ndarray:
+def door_depth_weight(grid: OccupancyGrid, start_xy: np.ndarray, params: RouteParams = RouteParams(),
+                      searches: PathSearches | None = None) -> np.ndarray:
     """Per cell, ``room_weight`` to the power of the doorways crossed from ``start_xy`` (m) to the space within
     ``front_m`` of it (float, in (0, 1]; unseen space counts as open, mapped walls block).
 
-    Searched on cells ``depth_pool`` times coarser, each as narrow as its narrowest fine cell."""
+    Searched on cells ``depth_pool`` times coarser, each as narrow as its narrowest fine cell. ``searches``:
+    path searches kept from earlier calls (the same answer, sooner)."""
+    searches = PathSearches() if searches is None else searches
     pool = max(1, params.depth_pool)
     res = grid.resolution * pool
-    clearance = ndimage.distance_transform_edt(~grid.occupied_mask()) * grid.resolution
+    # Clearance (m) exact up to just past what is asked of it (the robot's radius, half a door), inf beyond.
+    cap = int(math.ceil(max(params.robot_radius_m, params.door_width_m / 2) / grid.resolution)) + 1
+    clearance = distance_to_occupied(grid.occupied_mask(), cap).astype(float) * grid.resolution
     coarse = pool_cells(clearance, pool, 0.0, np.min)  # off the grid counts as wall
     passable = coarse > params.robot_radius_m
     narrow = coarse < params.door_width_m / 2
@@ -141,10 +169,9 @@ def door_depth_weight(grid: OccupancyGrid, start_xy: np.ndarray, params: RoutePa
     if not passable[rc[0], rc[1]]:
         _, (ir, ic) = ndimage.distance_transform_edt(~passable, return_indices=True)
         rc = np.array([ir[rc[0], rc[1]], ic[rc[0], rc[1]]])
-    seed = [tuple(int(v) for v in rc)]
-    cost = MCP_Geometric(np.where(passable, 1.0 + params.door_penalty_m * narrow, np.inf),
-                         fully_connected=True).find_costs(seed)[0] * res
-    plain = MCP_Geometric(np.where(passable, 1.0, np.inf), fully_connected=True).find_costs(seed)[0] * res
+    seed = (int(rc[0]), int(rc[1]))
+    cost = searches.lengths("doors", np.where(passable, 1.0 + params.door_penalty_m * narrow, np.inf), seed) * res
+    plain = searches.lengths("plain", np.where(passable, 1.0, np.inf), seed) * res
     with np.errstate(invalid="ignore"):
         doors = np.where(np.isfinite(cost) & np.isfinite(plain), (cost - plain) / params.door_cost_m, 6.0)
     weight = params.room_weight ** np.clip(doors, 0.0, 6.0)

@@ -43,13 +43,20 @@ def clearance_m(grid: OccupancyGrid) -> np.ndarray:
     return ndimage.distance_transform_edt(~grid.occupied_mask()) * grid.resolution
 
 
-def seen_passable(grid: OccupancyGrid, clearance: np.ndarray, robot_radius_m: float,
-                  fill_holes_cells: int) -> np.ndarray:
-    """Cells seen free (small unseen specks filled), more than the robot's radius (m) from any seen obstacle."""
+def filled_free(grid: OccupancyGrid, fill_holes_cells: int) -> np.ndarray:
+    """Cells seen free with unseen specks between beams filled (``fill_holes_cells`` closing iterations; none: the
+    free cells). Near the grid's edge the closing may also drop a free cell."""
     free = grid.free_mask()
-    if fill_holes_cells > 0:
-        free = ndimage.binary_closing(free, iterations=fill_holes_cells) & (clearance > 0)
-    return free & (clearance > robot_radius_m)
+    return ndimage.binary_closing(free, iterations=fill_holes_cells) if fill_holes_cells > 0 else free
+
+
+def seen_passable(grid: OccupancyGrid, clearance: np.ndarray, robot_radius_m: float,
+                  fill_holes_cells: int, filled: np.ndarray | None = None) -> np.ndarray:
+    """Cells seen free (small unseen specks filled), more than the robot's radius (m) from any seen obstacle;
+    ``filled``: :func:`filled_free` of the grid when already at hand."""
+    if filled is None:
+        filled = filled_free(grid, fill_holes_cells)
+    return filled & (clearance > 0) & (clearance > robot_radius_m)
 
 
 def nearest_seen_point(grid: OccupancyGrid, robot_xy: np.ndarray, goal_xy: np.ndarray, *,

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
-from sim.navigation.routes import Arrow, RouteParams, door_depth_weight, route_likelihood
+from sim.navigation.routes import Arrow, PathSearches, RouteParams, door_depth_weight, route_likelihood
 
 
 def grid_of(walls: list[tuple[float, float, float, float]], size: tuple[float, float] = (20.0, 12.0)
@@ -63,3 +63,23 @@ def test_a_room_behind_a_door_weighs_less_than_the_corridor_it_opens_on():
     assert at(grid, weight, *room_far_wall) == pytest.approx(params.room_weight, rel=0.5)
     wide = grid_of([(0.0, 8.0, 2.0, 2.2), (12.0, 20.0, 2.0, 2.2)])  # a 4 m opening: no door, one space
     assert at(wide, door_depth_weight(wide, np.array([2.0, 1.0]), params), *room_far_wall) == pytest.approx(1.0)
+
+
+def test_kept_path_searches_give_the_same_evidence_and_run_again_only_on_a_changed_map():
+    walls = [(0.0, 9.5, 2.0, 2.2), (10.5, 20.0, 2.0, 2.2)]
+    grid = grid_of(walls)
+    east = Arrow(sign_xy=(4.0, 1.0), facing=math.pi / 2, direction=0.0, wrong_prob=0.1)
+    searches = PathSearches()
+    start = np.array([2.0, 1.0])
+    depth, route = door_depth_weight(grid, start, searches=searches), route_likelihood(grid, [east], searches=searches)
+    found = dict(searches.found)
+    assert sorted(kind for kind, _ in found) == ["doors", "plain", "route", "route"]
+    assert np.array_equal(depth, door_depth_weight(grid, start, searches=searches))
+    assert np.array_equal(route, route_likelihood(grid, [east], searches=searches))
+    assert all(searches.found[key] is found[key] for key in found)  # the same map: no search run again
+    grid.log_odds[60:62, :] = 3.0  # a new wall across the room
+    moved = door_depth_weight(grid, start, searches=searches)
+    assert np.array_equal(moved, door_depth_weight(grid, start))
+    plain = next(key for key in found if key[0] == "plain")
+    assert searches.found[plain] is not found[plain]  # run again on the changed map
+    assert searches.found.keys() >= {key for key in found if key[0] == "route"}  # kept: only depth was asked
