@@ -19,10 +19,12 @@ import csv
 import hashlib
 import io
 import json
+import os
 import re
 import time
 import traceback
 from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -154,6 +156,25 @@ Unit = Any  # what an executor maps over: here a tuple of trial specs sharing on
 Result = Any  # what the mapped function returns for one unit
 
 
+THREAD_POOL_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+@contextmanager
+def one_thread_per_worker() -> Iterator[None]:
+    """Worker processes started within get one BLAS/OpenMP thread each, unless the caller set a count.
+
+    A study runs one trial per core; a numeric library's own pool in every worker would fight the other workers
+    for the same cores. The parent's environment is as it was afterwards.
+    """
+    unset = [name for name in THREAD_POOL_VARIABLES if name not in os.environ]
+    os.environ.update(dict.fromkeys(unset, "1"))
+    try:
+        yield
+    finally:
+        for name in unset:
+            os.environ.pop(name, None)
+
+
 class ProcessExecutor:
     """A local pool of worker processes."""
 
@@ -170,7 +191,7 @@ class ProcessExecutor:
         from concurrent.futures import ProcessPoolExecutor, as_completed
         from multiprocessing import get_context
 
-        with ProcessPoolExecutor(self.workers, mp_context=get_context("spawn")) as pool:
+        with one_thread_per_worker(), ProcessPoolExecutor(self.workers, mp_context=get_context("spawn")) as pool:
             futures = {pool.submit(fn, spec): spec for spec in specs}
             for future in as_completed(futures):
                 yield futures[future], future.result()

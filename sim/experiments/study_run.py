@@ -26,6 +26,7 @@ from sim.experiments.study import (
     TrialSpec,
     check_settings,
     make_executor,
+    one_thread_per_worker,
     plan_specs,
     run_study,
     slug,
@@ -55,7 +56,8 @@ def build_worlds(settings: StudySettings, out: Path, *, workers: int = 1) -> lis
         if len(missing) > 1 and workers > 1:
             from tqdm import tqdm
 
-            with ProcessPoolExecutor(min(workers, len(missing)), mp_context=get_context("spawn")) as pool:
+            with one_thread_per_worker(), ProcessPoolExecutor(min(workers, len(missing)),
+                                                              mp_context=get_context("spawn")) as pool:
                 list(tqdm(pool.map(generated_folder, missing, [root] * len(missing)), total=len(missing),
                           desc="building worlds", unit="world", file=sys.stderr, dynamic_ncols=True))
         return [generated_folder(g, root) for g in todo]

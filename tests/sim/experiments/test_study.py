@@ -225,3 +225,15 @@ def test_plan_goes_round_robin_over_worlds(tiny_world, tmp_path):
         (0, "tiny", "paper"), (0, "tiny", "frontier"), (0, "twin", "paper"), (0, "twin", "frontier"),
         (1, "tiny", "paper"), (1, "tiny", "frontier"), (1, "twin", "paper"), (1, "twin", "frontier")]
     assert all(s.oracle_m and s.oracle_m > 0 for s in specs)
+
+
+def test_workers_get_one_thread_unless_the_caller_set_a_count(monkeypatch):
+    import os
+
+    from sim.experiments.study import one_thread_per_worker
+
+    monkeypatch.delenv("OMP_NUM_THREADS", raising=False)
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "3")
+    with one_thread_per_worker():
+        assert os.environ["OMP_NUM_THREADS"] == "1" and os.environ["OPENBLAS_NUM_THREADS"] == "3"
+    assert "OMP_NUM_THREADS" not in os.environ and os.environ["OPENBLAS_NUM_THREADS"] == "3"
