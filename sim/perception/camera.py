@@ -217,22 +217,18 @@ class CameraPerception:
         prm = self.params
         radius = prm.max_range_m + prm.render_margin_m
         half_size = self.scene.world.tag_size * (8 + 2 * self.scene.params.tag_margin_cells) / 16.0
-        cone_cos = math.cos(math.radians(min(90.0, prm.cone_half_angle_deg + prm.render_cone_margin_deg)))
-        near = []
-        for pose in self.scene.tag_poses.values():
-            dx, dy = pose.x - x, pose.y - y
-            distance = math.hypot(dx, dy)
-            if distance > radius or distance < 1e-6:
-                continue
-            facing = -(dx * math.cos(pose.theta) + dy * math.sin(pose.theta)) / distance  # cos of the angle off
-            if facing <= cone_cos:
-                continue  # behind the face, or too oblique for any reading to pass the cone
-            near.append((pose, dx, dy, distance))
+        poses = list(self.scene.tag_poses.values())
+        faces = np.array([(pose.x, pose.y, pose.theta) for pose in poses]).reshape(-1, 3)
+        # in range and in front, within the widened cone: the reading rules with the margins above
+        drawn = readable(x, y, faces[:, 0], faces[:, 1], faces[:, 2], max_range_m=radius,
+                         cone_half_angle_deg=min(90.0, prm.cone_half_angle_deg + prm.render_cone_margin_deg))
+        near = [poses[i] for i in np.flatnonzero(drawn)]
         views: set[int] = set()
-        hidden_edges = self._edges_hidden(x, y, [pose for pose, *_ in near])
-        for (_, dx, dy, distance), hidden in zip(near, hidden_edges, strict=True):
+        for pose, hidden in zip(near, self._edges_hidden(x, y, near), strict=True):
             if hidden:
                 continue
+            dx, dy = pose.x - x, pose.y - y
+            distance = math.hypot(dx, dy)
             bearing = math.atan2(dy, dx)
             reach = prm.hfov / 2.0 + math.atan2(half_size, distance)
             for k in range(prm.n_views):

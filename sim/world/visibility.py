@@ -9,14 +9,15 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 
-def readable(camera_x: ArrayLike, camera_y: ArrayLike, tag_x: float, tag_y: float, tag_theta: float, *,
+def readable(camera_x: ArrayLike, camera_y: ArrayLike, tag_x: ArrayLike, tag_y: ArrayLike, tag_theta: ArrayLike, *,
              max_range_m: float, cone_half_angle_deg: float) -> Any:
     """Whether a tag at (tag_x, tag_y) facing tag_theta may be read from a camera at (camera_x, camera_y).
 
     The rules of the original study: within ``max_range_m`` (floor-plane
     distance) and in front of the tag, inside the cone of half-angle
     ``cone_half_angle_deg`` about its normal. Occlusion is not checked here.
-    Camera positions may be numbers (a bool is returned) or arrays (a bool array).
+    Camera or tag positions (and facings) may be numbers (a bool is returned) or arrays that broadcast
+    (a bool array).
     """
     dx, dy = np.subtract(camera_x, tag_x), np.subtract(camera_y, tag_y)
     distance = np.hypot(dx, dy)
