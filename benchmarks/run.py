@@ -59,19 +59,25 @@ def table(title: str, header: list[str], rows: list[list[str]]) -> None:
 LION_TAG_XY = (-21.6996, 17.703)  # m, the Lion's label in worlds/zoo/tags.json (tag 17)
 
 
-def lion_settles(checkout: Path, runs: int = 3) -> dict:
-    """The Lion replay's settles timed (CPU s) with ``checkout``'s abstract_map, in a child process."""
+def measure_in(checkout: Path, script: str, *args: str) -> dict:
+    """Run benchmarks/``script`` in a child process on ``checkout``'s code (one BLAS thread) and return the JSON
+    of its last line, after checking that it measured that checkout's abstract_map (its ``module``)."""
     import json
     import os
     import subprocess
 
     env = {**os.environ, "PYTHONPATH": str(checkout), "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
-    out = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "lion_settles.py"),
-                          str(ROOT / "worlds" / "zoo" / "lion_replay.json"), str(runs)],
+    out = subprocess.run([sys.executable, str(ROOT / "benchmarks" / script), *args],
                          env=env, cwd=checkout, capture_output=True, text=True, check=True)
     result = json.loads(out.stdout.strip().splitlines()[-1])
     if not Path(result["module"]).resolve().is_relative_to(checkout.resolve()):
         raise RuntimeError(f"measured {result['module']}, not the checkout {checkout}")
+    return result
+
+
+def lion_settles(checkout: Path, runs: int = 3) -> dict:
+    """The Lion replay's settles timed (CPU s) with ``checkout``'s abstract_map, in a child process."""
+    result = measure_in(checkout, "lion_settles.py", str(ROOT / "worlds" / "zoo" / "lion_replay.json"), str(runs))
     per_cue = [statistics.median(run[i] for run in result["cpu_s"]) for i in range(len(result["cpu_s"][0]))]
     result["per_cue"] = per_cue
     result["median"] = statistics.median(per_cue)
@@ -123,19 +129,7 @@ CAMPUS_CUES = {500: None, 5000: 30, 20000: 20}  # cues walked per size (None: th
 
 def campus_walk(checkout_dir: Path, n: int, cues: int | None) -> dict:
     """benchmarks/campus.py at ``n`` places with ``checkout_dir``'s abstract_map, in a child process."""
-    import json
-    import os
-    import subprocess
-
-    command = [sys.executable, str(ROOT / "benchmarks" / "campus.py"), str(n), "--json"]
-    if cues is not None:
-        command += ["--cues", str(cues)]
-    env = {**os.environ, "PYTHONPATH": str(checkout_dir), "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
-    out = subprocess.run(command, env=env, cwd=checkout_dir, capture_output=True, text=True, check=True)
-    figures = json.loads(out.stdout.strip().splitlines()[-1])
-    if not Path(figures["module"]).resolve().is_relative_to(checkout_dir.resolve()):
-        raise RuntimeError(f"measured {figures['module']}, not the checkout {checkout_dir}")
-    return figures
+    return measure_in(checkout_dir, "campus.py", str(n), "--json", *([] if cues is None else ["--cues", str(cues)]))
 
 
 def bench_campus(sizes: tuple[int, ...] = (500, 5000), cues: int | None = None, against: str | None = None) -> None:
