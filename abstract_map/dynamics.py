@@ -124,8 +124,8 @@ def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndar
         dv = new_velocity[:n_free] - velocity[:n_free]
         velocity = new_velocity
         # |v| < L_v and |a| < L_a for every free mass, with a = dv / dt
-        settled = bool((np.abs(velocity[:n_free]) < params.settle_velocity).all()
-                       and (np.abs(dv) < dv_limit).all())
+        settled = bool(np.abs(velocity[:n_free]).max() < params.settle_velocity
+                       and np.abs(dv).max() < dv_limit)
     return SettleResult(
         settled=settled,
         iterations=iterations,

@@ -75,15 +75,19 @@ class ForceField:
         pair_sign = np.concatenate([-np.ones(n_g), np.ones(n_r), -np.ones(n_r)])
         incidence = None
         if self.n * n_pairs <= _DENSE_LIMIT:  # small systems: one matrix product beats two bincounts
-            incidence = np.zeros((self.n, n_pairs))
+            # complex, so the product needs no cast; each pair's sign and the quarter turn to its tangent folded in
+            incidence = np.zeros((self.n, n_pairs), dtype=complex)
             np.add.at(incidence, (heads, np.arange(n_pairs)), 1.0)
             np.add.at(incidence, (tails, np.arange(n_pairs)), -1.0)
+            incidence *= 1j * pair_sign
         fields = {"_heads": heads, "_tails": tails, "_ends": np.concatenate([heads, tails]), "_incidence": incidence,
                   "_first": first, "_second": second,
                   "_pair_spring": pair_spring, "_pair_sign": pair_sign,
                   "_target": np.concatenate([self.g_angle, self.r_angle]),
-                  # scratch: pair angles and fade gains, the extra last entry being the x axis (angle 0, gain 1)
-                  "_angle": np.zeros(n_pairs + 1), "_gain": np.ones(n_pairs + 1),
+                  # scratch: pair angles (row 0) and fade gains (row 1), the extra last column being the x axis
+                  # (angle 0, gain 1), so one gather takes both for every spring's pairs
+                  "_angle_gain": np.vstack([np.zeros(n_pairs + 1), np.ones(n_pairs + 1)]),
+                  "_ends_of_springs": np.concatenate([second, first]),
                   "_k": np.concatenate([self.g_k, self.r_k])}
         for name, value in fields.items():
             object.__setattr__(self, name, value)
@@ -94,20 +98,23 @@ class ForceField:
         if len(heads):
             d = z[heads] - z[self._tails]  # type: ignore[attr-defined]
             length = np.abs(d)
-            angle, gain = self._angle, self._gain  # type: ignore[attr-defined]
-            np.arctan2(d.imag, d.real, out=angle[:-1])
+            angle_gain = self._angle_gain  # type: ignore[attr-defined]
+            np.arctan2(d.imag, d.real, out=angle_gain[0, :-1])
             if self.core > 0:
-                np.minimum(1.0, length / self.core, out=gain[:-1])
+                np.minimum(1.0, length / self.core, out=angle_gain[1, :-1])
             else:
-                gain[:-1] = length > 0
-            first, second = self._first, self._second  # type: ignore[attr-defined]
-            error = wrap(angle[second] - angle[first] - self._target)  # type: ignore[attr-defined]
-            spring = self._k * error * gain[first] * gain[second]  # type: ignore[attr-defined]
-            scale = self._pair_sign * spring[self._pair_spring] / np.maximum(length, 1e-9)  # type: ignore[attr-defined]
-            push = scale * 1j * d
+                angle_gain[1, :-1] = length > 0
+            n_springs = len(self._k)  # type: ignore[attr-defined]
+            ends = angle_gain[:, self._ends_of_springs]  # type: ignore[attr-defined]
+            second, first = ends[:, :n_springs], ends[:, n_springs:]
+            error = wrap(second[0] - first[0] - self._target)  # type: ignore[attr-defined]
+            spring = self._k * error * first[1] * second[1]  # type: ignore[attr-defined]
             if self._incidence is not None:  # type: ignore[attr-defined]
-                forces = self._incidence @ push  # type: ignore[attr-defined]
+                # the incidence holds each pair's sign and the turn 1j to its tangent
+                forces = self._incidence @ (spring[self._pair_spring] / np.maximum(length, 1e-9) * d)  # type: ignore[attr-defined]
             else:
+                scale = self._pair_sign * spring[self._pair_spring] / np.maximum(length, 1e-9)  # type: ignore[attr-defined]
+                push = scale * 1j * d
                 both = np.concatenate([push, -push])  # heads pushed, tails take the reaction
                 ends = self._ends  # type: ignore[attr-defined]
                 forces = np.bincount(ends, both.real, self.n) + 1j * np.bincount(ends, both.imag, self.n)
@@ -116,7 +123,10 @@ class ForceField:
         if self.centre is not None and len(self.expand) and self.expansion != 0.0:
             d = z[self.expand] - self.centre
             length = np.abs(d)
-            ok = length > 1e-9
-            magnitude = EXPANSION_LAWS[self.law](self.expansion, length) * ok
-            forces[self.expand] += magnitude / np.where(ok, length, 1.0) * d
+            magnitude = EXPANSION_LAWS[self.law](self.expansion, length)
+            if length.min() > 1e-9:
+                forces[self.expand] += magnitude / length * d
+            else:  # a mass at the centre has no direction to be pushed in
+                ok = length > 1e-9
+                forces[self.expand] += magnitude * ok / np.where(ok, length, 1.0) * d
         return forces

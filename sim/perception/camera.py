@@ -99,32 +99,30 @@ def refine_corners(grey: np.ndarray, quad: np.ndarray, samples: int = 12) -> np.
     centre = quad.mean(axis=0)
     cell = np.mean(np.linalg.norm(np.roll(quad, -1, axis=0) - quad, axis=1)) / 8.0
     offsets = np.linspace(-0.5 * cell, 0.5 * cell, 17)
-    lines = []
-    for i in range(4):
-        a, b = quad[i], quad[(i + 1) % 4]
+    starts, ends = quad, np.roll(quad, -1, axis=0)  # edge i runs from corner i to corner i + 1
+    normals = np.empty((4, 2))
+    for i, (a, b) in enumerate(zip(starts, ends)):
         direction = (b - a) / max(np.linalg.norm(b - a), 1e-9)
         normal = np.array([direction[1], -direction[0]])
-        if np.dot(normal, (a + b) / 2 - centre) < 0:
-            normal = -normal
-        ts = np.linspace(0.15, 0.85, samples)
-        base = a[None, :] + ts[:, None] * (b - a)[None, :]
-        profile = _sample(grey, base[:, None, :] + offsets[None, :, None] * normal[None, None, :])
-        level = 0.5 * (profile[:, 0] + profile[:, -1])
-        above = profile >= level[:, None]
-        points = []
-        for k in range(samples):
-            if profile[k, -1] - profile[k, 0] < 20.0:
-                continue
-            crossings = np.nonzero(~above[k, :-1] & above[k, 1:])[0]
-            if len(crossings) == 0:
-                continue
-            j = crossings[np.argmin(np.abs(offsets[crossings]))]
-            p0, p1 = profile[k, j], profile[k, j + 1]
-            s = offsets[j] + (level[k] - p0) / max(p1 - p0, 1e-6) * (offsets[j + 1] - offsets[j])
-            points.append(base[k] + s * normal)
-        if len(points) < 3:
+        normals[i] = -normal if np.dot(normal, (a + b) / 2 - centre) < 0 else normal  # pointing out of the square
+    ts = np.linspace(0.15, 0.85, samples)
+    base = starts[:, None, :] + ts[None, :, None] * (ends - starts)[:, None, :]  # (edge, sample, 2)
+    profile = _sample(grey, base[:, :, None, :] + offsets[None, None, :, None] * normals[:, None, None, :])
+    level = 0.5 * (profile[..., 0] + profile[..., -1])
+    above = profile >= level[..., None]
+    crossing = ~above[..., :-1] & above[..., 1:]  # dark to light between offsets j and j + 1
+    # per sample, the crossing nearest the expected edge; samples without contrast or crossing are dropped
+    j = np.where(crossing, np.abs(offsets[:-1]), np.inf).argmin(axis=2)
+    usable = (profile[..., -1] - profile[..., 0] >= 20.0) & crossing.any(axis=2)
+    p0 = np.take_along_axis(profile, j[..., None], axis=2)[..., 0]
+    p1 = np.take_along_axis(profile, j[..., None] + 1, axis=2)[..., 0]
+    across = offsets[j] + (level - p0) / np.maximum(p1 - p0, 1e-6) * (offsets[j + 1] - offsets[j])
+    points = base + across[..., None] * normals[:, None, :]
+    lines = []
+    for i in range(4):
+        if usable[i].sum() < 3:
             return quad
-        pts = np.array(points)
+        pts = points[i][usable[i]]
         mean = pts.mean(axis=0)
         _, _, vt = np.linalg.svd(pts - mean)
         lines.append((mean, vt[0]))
@@ -308,18 +306,21 @@ class CameraPerception:
                                    abs(u - self.intrinsics[0, 2]) / self.params.width_px, pixels))
         return found
 
-    def _project(self, t: np.ndarray, angle: float) -> np.ndarray:
-        """Pixels (4, 2) of the tag corners for an upright tag at t (camera frame, m) turned by ``angle`` (rad).
+    def _project(self, poses: np.ndarray) -> np.ndarray:
+        """Pixels (m, 8), corners' (u, v) in turn, of upright tags at poses (m, 4): centre t (camera frame, m) and
+        turn angle (rad) about the camera's vertical axis away from facing the camera.
 
-        ``angle`` turns the tag about the camera's vertical axis away from facing the camera.
+        The tag's x maps to the camera's x, its y (up) to -y, its z (out of the face) to -z, then the tag turns
+        about y; the corners lie in the tag's plane (z = 0), so each camera coordinate is one product.
         """
-        c, s = math.cos(angle), math.sin(angle)
-        # tag x -> camera x, tag y (up) -> -camera y, tag z (out of the face) -> -camera z; then turn about y
-        rotation = np.array([[c, 0.0, -s], [0.0, -1.0, 0.0], [-s, 0.0, -c]])
-        points = self._object_points @ rotation.T + t
+        angle = poses[:, 3:4]
+        ox, oy = self._object_points[:, 0], self._object_points[:, 1]
+        z = ox * -np.sin(angle) + poses[:, 2:3]
+        pixels = np.empty((len(poses), 4, 2))
         k = self.intrinsics
-        return np.stack([k[0, 0] * points[:, 0] / points[:, 2] + k[0, 2],
-                         k[1, 1] * points[:, 1] / points[:, 2] + k[1, 2]], axis=1)
+        pixels[:, :, 0] = k[0, 0] * (ox * np.cos(angle) + poses[:, 0:1]) / z + k[0, 2]
+        pixels[:, :, 1] = k[1, 1] * (-oy + poses[:, 1:2]) / z + k[1, 2]
+        return pixels.reshape(len(poses), 8)
 
     def _solve(self, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         """Pose of a tag from its corners: (centre, outward normal), camera frame; None if it fails.
@@ -354,22 +355,20 @@ class CameraPerception:
         """
         params = np.array([*t, angle], dtype=float)
         target = pixels.ravel()
+        steps = np.diag([1e-6, 1e-6, 1e-6, 1e-7])  # finite-difference step per parameter (m, m, m, rad)
         for _ in range(iterations):
-            residual = self._project(params[:3], params[3]).ravel() - target
+            projected = self._project(np.vstack([params, params + steps]))  # the fit and its 4 nudges
+            residual = projected[0] - target
             if params[2] <= 0 or not np.all(np.isfinite(residual)):
                 return params[:3], float(params[3]), math.inf
-            jacobian = np.empty((8, 4))
-            for j, h in enumerate((1e-6, 1e-6, 1e-6, 1e-7)):
-                step = params.copy()
-                step[j] += h
-                jacobian[:, j] = (self._project(step[:3], step[3]).ravel() - target - residual) / h
+            jacobian = ((projected[1:] - target - residual) / np.diag(steps)[:, None]).T
             delta = np.linalg.lstsq(jacobian, -residual, rcond=None)[0]
             params += delta
             if np.abs(delta).max() < 1e-8:
                 break
         if params[2] <= 0:
             return params[:3], float(params[3]), math.inf
-        error = float(np.sum((self._project(params[:3], params[3]).ravel() - target) ** 2))
+        error = float(np.sum((self._project(params[None, :])[0] - target) ** 2))
         return params[:3], float(params[3]), error if math.isfinite(error) else math.inf
 
     def observe(self, robot: Robot) -> list[Sighting]:

@@ -55,3 +55,8 @@ def test_dense_and_sparse_sums_agree(monkeypatch):
     monkeypatch.setattr(forces, "_DENSE_LIMIT", 0)
     sparse = field(6, **spec)(pos)
     assert np.allclose(dense, sparse)
+
+
+def test_expansion_spares_a_mass_at_the_centre():
+    f = field(2, expand=[0, 1], centre=1.0 + 1.0j, expansion=0.01)(np.array([1.0 + 1.0j, 1.0 + 3.0j]))
+    assert f[0] == 0 and f[1] == pytest.approx(0.01j)

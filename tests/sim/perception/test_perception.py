@@ -144,3 +144,29 @@ def test_camera_ignores_tags_of_other_worlds(tiny_scene, robot, perceptions):
         assert {s.tag_id for s in camera.observe(robot)} == {0}
     finally:
         p.removeBody(stranger, physicsClientId=cid)
+
+
+def test_upright_fit_recovers_a_tag_pose(perceptions):
+    camera = perceptions["camera"]
+    truth = np.array([0.3, -0.1, 2.5, 0.4])  # centre (camera frame, m) and turn (rad)
+    pixels = camera._project(truth[None, :])[0].reshape(4, 2)
+    t, angle, error = camera._upright(pixels, truth[:3] + [0.1, 0.05, -0.2], truth[3] - 0.2)
+    assert np.allclose(t, truth[:3], atol=1e-6) and angle == pytest.approx(truth[3], abs=1e-6)
+    assert error < 1e-12
+
+
+def test_corner_refinement_moves_corners_onto_the_square():
+    from sim.perception.camera import refine_corners
+
+    size, scale = 64, 8  # px, and samples per pixel along each axis
+    corners = np.array([[20.3, 18.6], [44.7, 19.4], [43.9, 43.8], [19.5, 43.1]])  # (u, v) px, pixel centres at integers
+    axis = (np.arange(size * scale) + 0.5) / scale - 0.5
+    u, v = np.meshgrid(axis, axis)
+    inside = np.ones_like(u, dtype=bool)
+    for a, b in zip(corners, np.roll(corners, -1, axis=0)):  # a convex quad: inside every edge's half-plane
+        inside &= (b[0] - a[0]) * (v - a[1]) - (b[1] - a[1]) * (u - a[0]) >= 0
+    grey = np.where(inside, 0.0, 255.0).reshape(size, scale, size, scale).mean(axis=(1, 3)).astype(np.float32)
+    given = corners + [[0.5, -0.4], [-0.5, 0.4], [0.4, 0.5], [-0.4, -0.5]]  # a detector's corners, 0.64 px off
+    refined = refine_corners(grey, given)
+    assert np.linalg.norm(refined - corners, axis=1).max() < 0.25
+    assert np.array_equal(refine_corners(np.full_like(grey, 128.0), corners), corners)  # no edge: kept as given
