@@ -9,6 +9,7 @@ It never waits on anything but the simulator's own steps.
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import time
@@ -33,6 +34,8 @@ from sim.perception.laser import LaserParams, laser_angles, scan
 from sim.world.data import World, load_world
 from sim.world.robot import Robot, RobotParams
 from sim.world.scene import SceneParams, build_scene
+
+logger = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -117,6 +120,7 @@ class TrialResult:
     grid_extent: tuple[float, float, float, float] | None = None
     navigator: str = "paper"  # the navigation policy's name (sim.navigation.policies.NAVIGATORS)
     cpu_s: float = math.nan  # s of this process's CPU time: unlike wall time, not stretched by a busy machine
+    unsettled: int = 0  # settles of the abstract map stopped by its step cap (DynamicsParams.max_iterations)
 
     @property
     def realtime_factor(self) -> float:
@@ -132,6 +136,7 @@ class TrialResult:
             "realtime_factor": round(self.realtime_factor, 2), "start": list(self.start),
             "cues": [asdict(c) for c in self.cues],
             "exploration_bumps": self.exploration_bumps, "settle_median_ms": round(self.settle_median_ms, 2),
+            "unsettled": self.unsettled,
             "final_positions": {k: [round(v[0], 3), round(v[1], 3)] for k, v in self.final_positions.items()},
             "trajectory": [[round(float(v), 3) for v in row] for row in self.trajectory],
         }
@@ -322,7 +327,8 @@ class Trial:
         frames = [*self.frames, self.snapshot(final)] if self.record else []
         if self.progress:
             self.progress(self.t, self.distance, len(self.policy.cues))
-        settle_ms = self.policy.settle_ms()
+        settles = self.policy.settles()
+        settle_ms = [s.wall_s * 1000 for s in settles[1:] or settles]  # the first settle places the whole hierarchy
         return TrialResult(
             world=self.world.name, goal=self.goal, seed=self.seed, perception=self.mode, success=self.success,
             reason=self.reason, distance_m=self.distance, sim_s=self.t, wall_s=time.perf_counter() - self.began,
@@ -330,6 +336,7 @@ class Trial:
             final_positions=self.policy.picture()[0], exploration_bumps=getattr(self.policy, "bumps", 0),
             settle_median_ms=float(np.median(settle_ms)) if settle_ms else 0.0, frames=frames,
             grid_extent=self.grid.extent, navigator=self.navigator, cpu_s=time.process_time() - self.began_cpu,
+            unsettled=sum(not s.settled for s in settles),
         )
 
 
@@ -377,6 +384,9 @@ def run_trial(world: World | str | os.PathLike[str], goal: str, *, seed: int = 0
             raise
         if recorder is not None:
             recorder.close(result)
+        if result.unsettled:
+            logger.warning("%s, %s: %d settle(s) of the abstract map stopped at the step cap with places still "
+                           "moving", result.world, result.goal, result.unsettled)
         return result
 
 

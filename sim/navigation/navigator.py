@@ -118,8 +118,8 @@ class Navigator:
         if explored_centre is not None:
             self.model.set_explored_centre(explored_centre)
         report = self.model.settle()
-        if not report.settled:
-            log.warning("abstract map not settled after %d steps", report.iterations)
+        if not report.settled:  # counted per trial (TrialResult.unsettled), so a study's log is not flooded
+            log.debug("abstract map not settled after %d steps", report.iterations)
         self.settles.append(report)
         return report
 

@@ -29,7 +29,7 @@ from typing import Protocol
 import numpy as np
 
 from abstract_map.clauses import Locational
-from abstract_map.model import imagined_positions
+from abstract_map.model import SettleReport, imagined_positions
 from sim.mapping.occupancy import OccupancyGrid
 from sim.navigation.belief import Belief, BeliefParams, SweptSpace, cue_mass, goal_belief, goal_sigma
 from sim.navigation.follower import FollowerParams, PathFollower, Recovery, RecoveryParams, StuckDetector, StuckParams
@@ -79,8 +79,8 @@ class Policy(Protocol):
     def picture(self) -> tuple[dict[str, tuple[float, float]], tuple[float, float], np.ndarray | None]:
         """For drawing: imagined places (m, may be empty), the current target (m) and planned path (N, 2 m)."""
 
-    def settle_ms(self) -> list[float]:
-        """Wall time (ms) of each settle of the policy's model after the first (empty: no model)."""
+    def settles(self) -> list[SettleReport]:
+        """Every settle of the policy's model, in order (empty: no model)."""
 
 
 class DriveStack:
@@ -150,9 +150,8 @@ class AbstractMapPolicy:
         """The model changed: the target chosen from it is chosen again."""
         self.target = None
 
-    def settle_ms(self) -> list[float]:
-        settles = self.nav.settles
-        return [s.wall_s * 1000 for s in settles[1:]] or [settles[0].wall_s * 1000]
+    def settles(self) -> list[SettleReport]:
+        return self.nav.settles
 
     def goal_prior(self) -> tuple[np.ndarray, float]:
         """The goal's imagined position (m; off the map too: a prior's near edge then lies on it) and the spread
@@ -307,7 +306,7 @@ class FrontierPolicy:
         plan = self.drive.plan
         return {}, self.search.shown(), None if plan is None else plan.waypoints
 
-    def settle_ms(self) -> list[float]:
+    def settles(self) -> list[SettleReport]:
         return []
 
 

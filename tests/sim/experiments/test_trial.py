@@ -92,3 +92,18 @@ def test_only_a_goal_blind_navigator_shares_a_run(tiny_world):
 
     with pytest.raises(ValueError, match="reads signs"):
         Trial(tiny_world, "A", perception="geometric", navigator="paper", also=["A"])
+
+
+def test_settles_stopped_at_their_cap_are_counted_and_warned_once(tiny_world, monkeypatch, caplog):
+    from dataclasses import replace
+
+    from abstract_map.model import AbstractMap
+
+    settle = AbstractMap.settle
+    monkeypatch.setattr(AbstractMap, "settle", lambda self: replace(settle(self), settled=False))
+    with caplog.at_level("WARNING"):
+        result = run_trial(tiny_world, "A", seed=1, perception="geometric")
+    assert result.unsettled >= 2  # the first placement and one per new cue
+    assert result.to_dict()["unsettled"] == result.unsettled
+    warnings = [r for r in caplog.records if r.levelname == "WARNING"]
+    assert len(warnings) == 1 and f"{result.unsettled} settle(s)" in warnings[0].getMessage()
