@@ -121,27 +121,27 @@ def tag_id(where: str, value: Any, error: type[AbstractMapError] = AbstractMapEr
     return integer(where, value, low=0, high=TAG_ID_LIMIT, error=error)
 
 
-def point(where: str, values: Any, *, error: type[AbstractMapError] = AbstractMapError) -> tuple[float, float]:
-    """(x m, y m) with finite coordinates in range."""
+def _sequence(where: str, values: Any, count: int, expected: str, error: type[AbstractMapError]) -> list[Any]:
+    """``values`` as a list of ``count`` items, or ``error`` saying what was ``expected``."""
     try:
         items = list(values)
     except TypeError:
-        raise error(f"{where}: expected (x, y) in metres, got {show(values)}") from None
-    if len(items) != 2:
-        raise error(f"{where}: expected (x, y) in metres, got {show(values)}")
-    return coordinate(f"{where} x", items[0], error), coordinate(f"{where} y", items[1], error)
+        raise error(f"{where}: expected {expected}, got {show(values)}") from None
+    if len(items) != count:
+        raise error(f"{where}: expected {expected}, got {show(values)}")
+    return items
+
+
+def point(where: str, values: Any, *, error: type[AbstractMapError] = AbstractMapError) -> tuple[float, float]:
+    """(x m, y m) with finite coordinates in range."""
+    x, y = _sequence(where, values, 2, "(x, y) in metres", error)
+    return coordinate(f"{where} x", x, error), coordinate(f"{where} y", y, error)
 
 
 def pose(where: str, values: Any, *, error: type[AbstractMapError] = AbstractMapError) -> tuple[float, float, float]:
     """(x m, y m, theta) with finite coordinates in range and a finite angle."""
-    try:
-        items = list(values)
-    except TypeError:
-        raise error(f"{where}: expected a pose (x m, y m, theta), got {show(values)}") from None
-    if len(items) != 3:
-        raise error(f"{where}: expected a pose of 3 numbers (x m, y m, theta), got {show(values)}")
-    return (coordinate(f"{where} x", items[0], error), coordinate(f"{where} y", items[1], error),
-            angle(f"{where} theta", items[2], error))
+    x, y, theta = _sequence(where, values, 3, "a pose of 3 numbers (x m, y m, theta)", error)
+    return coordinate(f"{where} x", x, error), coordinate(f"{where} y", y, error), angle(f"{where} theta", theta, error)
 
 
 def place_name(where: str, name: Any, *, error: type[AbstractMapError] = AbstractMapError) -> str:

@@ -49,6 +49,12 @@ def snap(v: float, step: float = SNAP_M) -> float:
     return round(round(v / step) * step, 6)
 
 
+def inside_walls(rect: RectT) -> RectT:
+    """The free part (m) of a room or hall whose ``rect`` runs to the middle of its walls."""
+    x0, y0, x1, y1 = rect
+    return (x0 + HALF_WALL_M, y0 + HALF_WALL_M, x1 - HALF_WALL_M, y1 - HALF_WALL_M)
+
+
 def edge_key(a: Node, b: Node) -> Edge:
     return (a, b) if a <= b else (b, a)
 
@@ -96,8 +102,7 @@ class Room:
 
     @property
     def free(self) -> RectT:
-        x0, y0, x1, y1 = self.rect
-        return (x0 + HALF_WALL_M, y0 + HALF_WALL_M, x1 - HALF_WALL_M, y1 - HALF_WALL_M)
+        return inside_walls(self.rect)
 
 
 @dataclass
@@ -110,8 +115,7 @@ class Hall:
 
     @property
     def free(self) -> RectT:
-        x0, y0, x1, y1 = self.rect
-        return (x0 + HALF_WALL_M, y0 + HALF_WALL_M, x1 - HALF_WALL_M, y1 - HALF_WALL_M)
+        return inside_walls(self.rect)
 
 
 @dataclass
