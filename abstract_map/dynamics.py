@@ -69,6 +69,18 @@ def _indices(springs: Sequence[Resolved], kind: str, index: Mapping[str, int], w
     return (*ends.T, np.array([s.value for s in chosen]), np.array([s.stiffness for s in chosen]))
 
 
+def angle_lengths(springs: Sequence[Resolved], kind: str, default: float) -> np.ndarray:
+    """Per angle spring of ``kind``, the natural length (m) of the stiffest distance spring between its pivot and
+    the place it turns (global: reference and figure; relative: vertex and its second place), or ``default``."""
+    natural: dict[frozenset[str], Resolved] = {}
+    for s in springs:
+        key = frozenset(s.ends)
+        if s.kind == "distance" and (key not in natural or s.stiffness > natural[key].stiffness):
+            natural[key] = s
+    return np.array([natural[key].value if (key := frozenset(s.ends[-2:])) in natural else default
+                     for s in springs if s.kind == kind], dtype=float)
+
+
 def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndarray],
            fixed: Mapping[str, np.ndarray], springs: Sequence[Resolved], *,
            expand: Sequence[str], centre: np.ndarray | None, params: DynamicsParams) -> SettleResult:
@@ -105,6 +117,9 @@ def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndar
         expand=np.array([index[n] for n in expand if n in index and index[n] < n_free], dtype=int),
         centre=None if centre is None else complex(float(centre[0]), float(centre[1])),
         expansion=params.expansion, law=params.expansion_law, core=params.angle_core,
+        angle_law=params.angle_law,
+        g_length=angle_lengths(springs, "global_angle", params.angle_length),
+        r_length=angle_lengths(springs, "relative_angle", params.angle_length),
     )
     state = _BodyState(space, len(bodies))
     pos, velocity = state.read()

@@ -3,9 +3,11 @@
 Positions are complex numbers ``x + iy`` in metres, world frame; forces are
 newtons, complex likewise.
 Angle springs push tangentially with magnitude ``K * error`` (N, with the
-error in radians), faded linearly to zero within ``core`` metres of their pivot
-where the angle is ill-defined; the reaction on the reference or vertex keeps
-each spring's net force zero. The expansion force pushes masses away from the
+error in radians; the "constant" law) or ``K * error * l / r`` (the "potential"
+law: the gradient of ``K l error^2 / 2``, ``r`` the distance from the pivot),
+faded linearly to zero within ``core`` metres of their pivot where the angle is
+ill-defined; the reaction on the reference or vertex keeps each spring's net
+force zero. The expansion force pushes masses away from the
 centre of explored space, with a constant or a proportional law.
 """
 
@@ -61,6 +63,9 @@ class ForceField:
     expansion: float = 0.0  # N or N/m, by law
     law: str = "constant"
     core: float = 0.5  # m
+    angle_law: str = "constant"  # "constant": K * error (N); "potential": K * error * length / r
+    g_length: np.ndarray | None = None  # m per global spring, for the potential law (None: 1 m)
+    r_length: np.ndarray | None = None  # m per relative spring, likewise
 
     def __post_init__(self) -> None:
         n_g, n_r = len(self.g_ref), len(self.r_a)
@@ -88,7 +93,11 @@ class ForceField:
                   # (angle 0, gain 1), so one gather takes both for every spring's pairs
                   "_angle_gain": np.vstack([np.zeros(n_pairs + 1), np.ones(n_pairs + 1)]),
                   "_ends_of_springs": np.concatenate([second, first]),
-                  "_k": np.concatenate([self.g_k, self.r_k])}
+                  "_k": np.concatenate([self.g_k, self.r_k]),
+                  # potential law: each pair's force is also scaled by its spring's length over the pair's length
+                  "_pair_length": None if self.angle_law == "constant" else np.concatenate([
+                      np.ones(n_g) if self.g_length is None else self.g_length,
+                      np.ones(n_r) if self.r_length is None else self.r_length])[pair_spring]}
         for name, value in fields.items():
             object.__setattr__(self, name, value)
 
@@ -109,11 +118,14 @@ class ForceField:
             second, first = ends[:, :n_springs], ends[:, n_springs:]
             error = wrap(second[0] - first[0] - self._target)  # type: ignore[attr-defined]
             spring = self._k * error * first[1] * second[1]  # type: ignore[attr-defined]
+            per_pair = spring[self._pair_spring] / np.maximum(length, 1e-9)  # type: ignore[attr-defined]
+            if self._pair_length is not None:  # type: ignore[attr-defined]
+                per_pair *= self._pair_length / np.maximum(length, 1e-9)  # type: ignore[attr-defined]
             if self._incidence is not None:  # type: ignore[attr-defined]
                 # the incidence holds each pair's sign and the turn 1j to its tangent
-                forces = self._incidence @ (spring[self._pair_spring] / np.maximum(length, 1e-9) * d)  # type: ignore[attr-defined]
+                forces = self._incidence @ (per_pair * d)  # type: ignore[attr-defined]
             else:
-                scale = self._pair_sign * spring[self._pair_spring] / np.maximum(length, 1e-9)  # type: ignore[attr-defined]
+                scale = self._pair_sign * per_pair  # type: ignore[attr-defined]
                 push = scale * 1j * d
                 both = np.concatenate([push, -push])  # heads pushed, tails take the reaction
                 ends = self._ends  # type: ignore[attr-defined]

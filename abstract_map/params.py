@@ -70,6 +70,12 @@ class DynamicsParams:
     expansion_on: str = "leaves"  # "leaves" (authors' code) or "all" free masses
     min_separation: float = 0.2  # m between free masses (they bounce)
     angle_core: float = 0.5  # m, angle spring forces fade to zero inside this distance of their pivot
+    # "constant": an angle spring pushes with K * error (N) at any distance (the authors' code); "potential": with
+    # K * error * l / r, the force of the energy K l error^2 / 2, l being the natural length of the distance spring
+    # between the same places (the same force as "constant" there). "constant" has curl, so masses can orbit
+    # for ever (docs/method-notes.md, "settles that never come to rest"); "potential" cannot
+    angle_law: str = "constant"
+    angle_length: float = 1.0  # m, l for an angle spring with no distance spring between its places
     dt: float = 0.1  # s, integration step (paper: Runge-Kutta with dt 0.1; here pymunk's integrator)
     settle_acceleration: float = 0.1  # m/s^2, L_a
     settle_velocity: float = 0.1  # m/s, L_v
@@ -78,7 +84,8 @@ class DynamicsParams:
     def __post_init__(self) -> None:
         _choice("DynamicsParams.expansion_law", self.expansion_law, ("constant", "proportional"))
         _choice("DynamicsParams.expansion_on", self.expansion_on, ("leaves", "all"))
-        for name in ("mass", "settle_acceleration", "settle_velocity"):
+        _choice("DynamicsParams.angle_law", self.angle_law, ("constant", "potential"))
+        for name in ("mass", "settle_acceleration", "settle_velocity", "angle_length"):
             _positive(f"DynamicsParams.{name}", getattr(self, name))
         _positive("DynamicsParams.dt", self.dt, high=10.0)
         if isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int):

@@ -84,7 +84,8 @@ def params_from_dict(data: Any, *, where: str = "params") -> AbstractMapParams:
             raise ModelFileError(f"{where} scales place: expected a level pair such as '1-2', got {key!r}")
         place[(_level(f"{where} scales place", parts[0]), _level(f"{where} scales place", parts[1]))] = \
             errors.number(f"{where} scales place[{key}]", value, error=ModelFileError)
-    dynamics = _object(f"{where} dynamics", data["dynamics"], tuple(f.name for f in fields(DynamicsParams)))
+    dynamics = _object(f"{where} dynamics", data["dynamics"], tuple(f.name for f in fields(DynamicsParams)),
+                       optional=("angle_law", "angle_length"))  # files from before the potential law
     exploration = _object(f"{where} exploration", data["exploration"],
                           tuple(f.name for f in fields(ExplorationParams)), optional=("max_factor",))
     try:
