@@ -68,6 +68,8 @@ class ForceField:
     r_length: np.ndarray | None = None  # m per relative spring, likewise
 
     def __post_init__(self) -> None:
+        if self.angle_law not in ("constant", "potential"):
+            raise ValueError(f"ForceField.angle_law must be 'constant' or 'potential', got {self.angle_law!r}")
         n_g, n_r = len(self.g_ref), len(self.r_a)
         heads = np.concatenate([self.g_fig, self.r_a, self.r_b]).astype(int)
         tails = np.concatenate([self.g_ref, self.r_vertex, self.r_vertex]).astype(int)
