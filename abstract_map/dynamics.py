@@ -110,6 +110,7 @@ def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndar
             a, b = bodies[index[s.ends[0]]], bodies[index[s.ends[1]]]
             space.add(pymunk.DampedSpring(a, b, (0, 0), (0, 0), s.value, s.stiffness, 0.0))
     n_free = len(free)
+    uses_lengths = params.angle_law != "constant"
     field = ForceField(
         len(bodies),
         *_indices(springs, "global_angle", index, 2),
@@ -117,9 +118,9 @@ def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndar
         expand=np.array([index[n] for n in expand if n in index and index[n] < n_free], dtype=int),
         centre=None if centre is None else complex(float(centre[0]), float(centre[1])),
         expansion=params.expansion, law=params.expansion_law, core=params.angle_core,
-        angle_law=params.angle_law,
-        g_length=angle_lengths(springs, "global_angle", params.angle_length),
-        r_length=angle_lengths(springs, "relative_angle", params.angle_length),
+        angle_law=params.angle_law,  # the lengths below only the potential law uses
+        g_length=angle_lengths(springs, "global_angle", params.angle_length) if uses_lengths else None,
+        r_length=angle_lengths(springs, "relative_angle", params.angle_length) if uses_lengths else None,
     )
     state = _BodyState(space, len(bodies))
     pos, velocity = state.read()

@@ -27,6 +27,9 @@ EXPANSION_LAWS: dict[str, Callable[[float, np.ndarray], np.ndarray]] = {
 }
 
 
+ANGLE_LAWS = ("constant", "potential")  # K * error (N), or K * error * l / r (see the module's docstring)
+
+
 def wrap(angle: np.ndarray) -> np.ndarray:
     """Angles wrapped to [-pi, pi)."""
     return (angle + np.pi) % (2 * np.pi) - np.pi
@@ -68,8 +71,8 @@ class ForceField:
     r_length: np.ndarray | None = None  # m per relative spring, likewise
 
     def __post_init__(self) -> None:
-        if self.angle_law not in ("constant", "potential"):
-            raise ValueError(f"ForceField.angle_law must be 'constant' or 'potential', got {self.angle_law!r}")
+        if self.angle_law not in ANGLE_LAWS:
+            raise ValueError(f"ForceField.angle_law must be one of {ANGLE_LAWS}, got {self.angle_law!r}")
         n_g, n_r = len(self.g_ref), len(self.r_a)
         heads = np.concatenate([self.g_fig, self.r_a, self.r_b]).astype(int)
         tails = np.concatenate([self.g_ref, self.r_vertex, self.r_vertex]).astype(int)

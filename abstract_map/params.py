@@ -9,6 +9,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from .forces import ANGLE_LAWS, EXPANSION_LAWS
+
 STIFFNESS: dict[str, float] = {"XL": 2.5, "L": 1.0, "M": 0.5, "S": 0.1, "XS": 0.01}
 """Named spring stiffnesses (N/m for distance springs, N/rad for angle springs)."""
 
@@ -82,9 +84,9 @@ class DynamicsParams:
     max_iterations: int = 5000  # steps before settle() gives up and reports "not settled"
 
     def __post_init__(self) -> None:
-        _choice("DynamicsParams.expansion_law", self.expansion_law, ("constant", "proportional"))
+        _choice("DynamicsParams.expansion_law", self.expansion_law, tuple(EXPANSION_LAWS))
         _choice("DynamicsParams.expansion_on", self.expansion_on, ("leaves", "all"))
-        _choice("DynamicsParams.angle_law", self.angle_law, ("constant", "potential"))
+        _choice("DynamicsParams.angle_law", self.angle_law, ANGLE_LAWS)
         for name in ("mass", "settle_acceleration", "settle_velocity", "angle_length"):
             _positive(f"DynamicsParams.{name}", getattr(self, name))
         _positive("DynamicsParams.dt", self.dt, high=10.0)
