@@ -60,15 +60,11 @@ def look(grid: OccupancyGrid, covered: np.ndarray, robot_xy: np.ndarray, params:
     in line of sight over the grid (a ray stops at the first occupied cell, which it marks); ``rays``:
     :func:`look_rays` for this grid when already at hand."""
     offsets = look_rays(grid, params) if rays is None else rays
-    x = robot_xy[0] + offsets[0]
-    y = robot_xy[1] + offsets[1]
-    rows, cols = grid.shape
-    x0, y0 = grid.origin
-    # world_to_cell, on the (rays, samples) arrays as they are
-    col = np.floor((x - x0) / grid.resolution).astype(int)
-    row = rows - 1 - np.floor((y - y0) / grid.resolution).astype(int)
-    inside = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
-    values = np.zeros(x.shape, dtype=np.float32)  # outside the grid: unknown
+    shape = offsets.shape[1:]  # (rays, samples)
+    rc = grid.world_to_cell(np.asarray(robot_xy, dtype=float)[:2] + offsets.reshape(2, -1).T)
+    inside = grid.in_bounds(rc).reshape(shape)
+    row, col = rc[:, 0].reshape(shape), rc[:, 1].reshape(shape)
+    values = np.zeros(shape, dtype=np.float32)  # outside the grid: unknown
     values[inside] = grid.log_odds[row[inside], col[inside]]
     occupied = values > grid.params.occupied_threshold
     known = occupied | (values < grid.params.free_threshold)
