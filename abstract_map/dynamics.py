@@ -15,6 +15,7 @@ Viscous friction is pymunk's space damping, exact for linear friction.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -61,6 +62,10 @@ class SettleResult:
     iterations: int
     positions: dict[str, np.ndarray]  # m, world frame, free masses
     velocities: dict[str, np.ndarray]  # m/s
+    stopped_by: str = ""  # why it stopped unsettled: "steps" (the step cap) or "time" (the time cap); "" if settled
+
+
+_CLOCK_EVERY = 16  # steps between looks at the clock under a time cap (a step is tens of microseconds or more)
 
 
 def _indices(springs: Sequence[Resolved], kind: str, index: Mapping[str, int], width: int) -> tuple[np.ndarray, ...]:
@@ -83,8 +88,12 @@ def angle_lengths(springs: Sequence[Resolved], kind: str, default: float) -> np.
 
 def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndarray],
            fixed: Mapping[str, np.ndarray], springs: Sequence[Resolved], *,
-           expand: Sequence[str], centre: np.ndarray | None, params: DynamicsParams) -> SettleResult:
-    """Integrate until every free mass has |a| < L_a and |v| < L_v, or ``params.max_iterations``."""
+           expand: Sequence[str], centre: np.ndarray | None, params: DynamicsParams,
+           max_steps: int | None = None, max_s: float | None = None) -> SettleResult:
+    """Integrate until every free mass has |a| < L_a and |v| < L_v, or a cap: ``max_steps`` steps (default
+    ``params.max_iterations``) or ``max_s`` seconds of wall time (default none), whichever comes first."""
+    step_cap = params.max_iterations if max_steps is None else max_steps
+    deadline = math.inf if max_s is None else time.perf_counter() + max_s
     free = list(positions)
     names = free + list(fixed)
     index = {name: i for i, name in enumerate(names)}
@@ -128,7 +137,14 @@ def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndar
         raise RuntimeError("pymunk returned bodies in an unexpected order")
     dv_limit = params.settle_acceleration * params.dt
     settled, iterations = n_free == 0, 0
-    while not settled and iterations < params.max_iterations:
+    stopped_by = ""
+    while not settled:
+        if iterations >= step_cap:
+            stopped_by = "steps"
+            break
+        if iterations % _CLOCK_EVERY == 0 and iterations and time.perf_counter() >= deadline:
+            stopped_by = "time"
+            break
         # Chipmunk moves bodies (x += v dt) before it applies forces and spring impulses, so
         # forces are taken at those positions; a one-step lag would feed energy into the system.
         ahead = pos + velocity * params.dt
@@ -145,6 +161,7 @@ def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndar
     return SettleResult(
         settled=settled,
         iterations=iterations,
+        stopped_by=stopped_by,
         positions={n: np.array([pos[i].real, pos[i].imag]) for i, n in enumerate(free)},
         velocities={n: np.array([velocity[i].real, velocity[i].imag]) for i, n in enumerate(free)},
     )

@@ -3,9 +3,11 @@
 Example:
   abstract-map imagine worlds/zoo/lion_replay.json --out r.json --plot lion.png
 
-Writes {"steps": [{"settled", "iterations", "wall_s", "positions", "goal"}, ...]},
-the first entry being the model of the hierarchy alone. Prints one progress
-line per step and the median settle time.
+Writes {"steps": [{"settled", "stopped_by", "iterations", "wall_s", "positions",
+"goal"}, ...]}, the first entry being the model of the hierarchy alone.
+"stopped_by" says which cap ended a settle that did not come to rest ("steps"
+or "time"; "" when it settled). Prints one progress line per step and the
+median settle time.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from . import errors
 from .cli import distinct_outputs, output_file
 from .files import write_text_atomic
 from .scenario import load_scenario, replay
@@ -31,6 +34,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=Path, required=True, help="where to write the result JSON")
     parser.add_argument("--plot", type=Path, help="also draw the final imagined map to this PNG")
     parser.add_argument("--save-model", type=Path, help="also save the final model (versioned JSON)")
+    parser.add_argument("--max-steps", type=int, help="cap each settle at this many steps (default: the model's "
+                        "max_iterations, 5000)")
+    parser.add_argument("--max-s", type=float, help="cap each settle at this many seconds of wall time (default: "
+                        "none)")
     parser.add_argument("--quiet", action="store_true", help="no progress lines")
 
 
@@ -42,16 +49,20 @@ def run(args: argparse.Namespace) -> int:
         output_file("--save-model", args.save_model)
     distinct_outputs(scenario=args.scenario, **{"--out": args.out, "--plot": args.plot,
                                                 "--save-model": args.save_model})
+    if args.max_steps is not None:
+        errors.integer("--max-steps", args.max_steps, low=1, high=10**9)
+    if args.max_s is not None:
+        errors.number("--max-s", args.max_s, low=1e-6, high=1e9)
     scenario = load_scenario(args.scenario)
 
     def progress(i: int, n: int, record: dict[str, Any]) -> None:
         if not args.quiet:
             goal = "" if record["goal"] is None else " goal ({:.2f}, {:.2f})".format(*record["goal"])
-            state = "settled" if record["settled"] else "NOT settled"
+            state = "settled" if record["settled"] else f"NOT settled (the {record['stopped_by']} cap)"
             print(f"[{i}/{n}] {record['cue']}: {state} in {record['iterations']} steps, "
                   f"{record['wall_s'] * 1000:.1f} ms{goal}", file=sys.stderr)
 
-    model, records = replay(scenario, progress=progress)
+    model, records = replay(scenario, progress=progress, max_steps=args.max_steps, max_s=args.max_s)
     write_text_atomic(args.out, json.dumps({"scenario": str(args.scenario), "steps": records}, indent=1,
                                            allow_nan=False))
     if args.plot:

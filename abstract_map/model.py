@@ -67,6 +67,7 @@ class SettleReport:
     iterations: int
     wall_s: float
     new_masses: tuple[str, ...] = ()
+    stopped_by: str = ""  # why it stopped unsettled: "steps" (the step cap) or "time" (the time cap); "" if settled
 
 
 @dataclass(frozen=True)
@@ -373,8 +374,17 @@ class AbstractMap:
             return
         self.explored_centre = np.array(errors.point("explored centre", xy, error=ModelError))
 
-    def settle(self) -> SettleReport:
-        """Place new masses (Algorithm 2), then integrate until settled (Algorithm 1)."""
+    def settle(self, *, max_steps: int | None = None, max_s: float | None = None) -> SettleReport:
+        """Place new masses (Algorithm 2), then integrate until settled (Algorithm 1) or a cap is hit.
+
+        ``max_steps``: steps for this call (default ``params.dynamics.max_iterations``); ``max_s``: seconds of
+        wall time for this call (default none; the clock is read every 16 steps, so a few may run over). A
+        capped settle keeps where the masses got to, its report says which cap stopped it, and the next
+        settle carries on from there."""
+        if max_steps is not None:
+            max_steps = errors.integer("settle max_steps", max_steps, low=1, high=10**9, error=ModelError)
+        if max_s is not None:
+            max_s = errors.number("settle max_s", max_s, low=1e-6, high=1e9, error=ModelError)
         began = time.perf_counter()
         springs = self.resolved_springs()
         places = self.places()
@@ -391,7 +401,9 @@ class AbstractMap:
         expand = leaves if self.params.dynamics.expansion_on == "leaves" else places
         result = run_dynamics({p: self.positions[p] for p in places}, self.velocities,
                               {n: f.xy for n, f in self.fixed.items()}, springs,
-                              expand=expand, centre=self.explored_centre, params=self.params.dynamics)
+                              expand=expand, centre=self.explored_centre, params=self.params.dynamics,
+                              max_steps=max_steps,
+                              max_s=None if max_s is None else max(1e-9, max_s - (time.perf_counter() - began)))
         bad = [n for n, xy in result.positions.items() if not np.all(np.abs(xy) <= errors.COORDINATE_LIMIT_M)]
         if bad:  # never expected with checked inputs: refuse rather than hand out NaN
             for name in placed:
@@ -401,7 +413,8 @@ class AbstractMap:
                              "the model is unchanged")
         self.positions.update(result.positions)
         self.velocities.update(result.velocities)
-        return SettleReport(result.settled, result.iterations, time.perf_counter() - began, tuple(new))
+        return SettleReport(result.settled, result.iterations, time.perf_counter() - began, tuple(new),
+                            result.stopped_by)
 
 
 EXPLORATION_LAWS = {

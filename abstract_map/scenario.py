@@ -152,7 +152,7 @@ def _record(model: AbstractMap, report: SettleReport, label: str) -> dict[str, A
     goal = None
     if model.goal is not None:
         goal = [float(v) for v in model.goal_estimate()]
-    return {"cue": label, "settled": report.settled, "iterations": report.iterations,
+    return {"cue": label, "settled": report.settled, "stopped_by": report.stopped_by, "iterations": report.iterations,
             "wall_s": round(report.wall_s, 6), "exploration_factor": model.exploration_factor,
             "positions": {n: [round(x, 6), round(y, 6)] for n, (x, y) in imagined_positions(model).items()},
             "goal": goal}
@@ -163,12 +163,14 @@ Progress = Callable[[int, int, dict[str, Any]], None]
 
 
 def replay(scenario: Scenario, *, params: AbstractMapParams | None = None,
-           progress: Progress | None = None) -> tuple[AbstractMap, list[dict[str, Any]]]:
-    """Settle after the hierarchy and after every step; one record per settle."""
+           progress: Progress | None = None, max_steps: int | None = None,
+           max_s: float | None = None) -> tuple[AbstractMap, list[dict[str, Any]]]:
+    """Settle after the hierarchy and after every step; one record per settle. ``max_steps`` and ``max_s``
+    cap each settle (:meth:`AbstractMap.settle`)."""
     model = AbstractMap.from_hierarchy(scenario.hierarchy, scenario.start, goal=scenario.goal, params=params)
     visited = [np.array(scenario.start[:2])]
     model.set_explored_centre(visited[0])
-    records = [_record(model, model.settle(), "hierarchy")]
+    records = [_record(model, model.settle(max_steps=max_steps, max_s=max_s), "hierarchy")]
     if progress:
         progress(0, len(scenario.steps), records[-1])
     for i, step in enumerate(scenario.steps, start=1):
@@ -181,7 +183,7 @@ def replay(scenario: Scenario, *, params: AbstractMapParams | None = None,
             label = "untagged cue"
         model.set_explored_centre(step.explored_centre if step.explored_centre is not None
                                   else np.mean(visited, axis=0))
-        records.append(_record(model, model.settle(), label))
+        records.append(_record(model, model.settle(max_steps=max_steps, max_s=max_s), label))
         if progress:
             progress(i, len(scenario.steps), records[-1])
     return model, records

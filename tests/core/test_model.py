@@ -210,3 +210,42 @@ def test_two_places_on_the_same_arrows_settle_under_the_potential_law():
     a, b = result.positions.values()
     assert np.linalg.norm(a - b) < 0.5  # side by side, between the two arrows' points (29.7, 9.7) and (22.7, 16.7)
     assert all(22.7 < p[0] < 29.8 and 9.7 < p[1] < 16.8 for p in (a, b))
+
+
+def test_a_settle_capped_per_call_says_which_cap_and_the_next_carries_on():
+    scenario = load_scenario(LION)
+    free, same = (replay(scenario)[1] for _ in range(2))
+    model, capped = replay(scenario, max_steps=10)
+    timeless = lambda records: [{k: v for k, v in r.items() if k != "wall_s"} for r in records]  # noqa: E731
+    assert timeless(same) == timeless(free)  # no cap given: the model's own, as before
+    long = [i for i, r in enumerate(free) if r["iterations"] > 10]
+    assert long and all(free[i]["settled"] and free[i]["stopped_by"] == "" for i in long)
+    assert all(not capped[i]["settled"] and capped[i]["stopped_by"] == "steps" and capped[i]["iterations"] == 10
+               for i in long)
+    assert capped[-1]["positions"] != free[-1]["positions"]
+    before = {p: xy.copy() for p, xy in model.positions.items()}
+    again = model.settle(max_steps=10)  # no new cue: carries on from where the last one stopped
+    assert again.stopped_by == "steps" and any(not np.array_equal(before[p], model.positions[p]) for p in before)
+
+
+def test_a_settle_capped_in_time_stops_on_the_clock():
+    _, records = replay(load_scenario(LION), max_s=1e-6)
+    stopped = [r for r in records if not r["settled"]]
+    assert stopped and all(r["stopped_by"] == "time" and r["iterations"] == 16 for r in stopped)
+    assert all(r["iterations"] <= 16 for r in records)
+
+
+@pytest.mark.parametrize("kwargs", [{"max_steps": 0}, {"max_steps": 2.5}, {"max_s": 0.0}, {"max_s": float("nan")}])
+def test_a_bad_settle_cap_is_named(kwargs):
+    from abstract_map.model import ModelError
+
+    with pytest.raises(ModelError, match="settle max_"):
+        make_map().settle(**kwargs)
+
+
+def test_imagine_refuses_a_bad_cap_in_one_line(tmp_path, capsys):
+    from abstract_map.cli import main
+
+    assert main(["imagine", str(LION), "--out", str(tmp_path / "r.json"), "--max-s", "-1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--max-s" in err[0] and not (tmp_path / "r.json").exists()
