@@ -143,3 +143,111 @@ def test_a_look_stops_at_walls_and_kept_rays_mark_the_same_cells():
     assert seen(1.0, 2.0) and seen(2.85, 2.0)  # free, and the wall's first cell
     assert not seen(3.05, 2.0) and not seen(3.5, 2.0)  # in and behind the wall
     assert not seen(1.0, 5.4)  # free and in line of sight, but 3.5 m away: beyond look_radius_m
+
+
+def door_grid() -> OccupancyGrid:
+    """10 m x 6 m, all mapped: a corridor below a wall at y = 2.0-2.2 m with a 1 m doorway at x = 4-5 m."""
+    grid = OccupancyGrid(OccupancyParams(resolution_m=0.1, bounds=(0.0, 10.0, 0.0, 6.0)))
+    xy = grid.cell_to_world(np.argwhere(np.ones(grid.shape, dtype=bool)))
+    cells = grid.world_to_cell(xy)
+    grid.log_odds[cells[:, 0], cells[:, 1]] = -2.0
+    wall = (xy[:, 1] > 2.0) & (xy[:, 1] < 2.2) & ~((xy[:, 0] > 4.0) & (xy[:, 0] < 5.0))
+    grid.log_odds[cells[wall, 0], cells[wall, 1]] = 3.0
+    return grid
+
+
+def test_label_walls_are_the_faces_beside_a_doorway_on_both_sides():
+    from sim.navigation.frontier import label_walls, wall_faces
+
+    grid = door_grid()
+    walls = label_walls(grid.occupied_mask(), grid.free_mask(), grid.resolution, PARAMS)
+    xy = grid.cell_to_world(np.argwhere(walls))
+    assert walls.sum() == 32  # 8 cells (0.8 m) each side of the doorway, on both faces of the 2-cell wall
+    assert xy[:, 0].min() > 3.2 and xy[:, 0].max() < 5.8 and not ((xy[:, 0] > 4.0) & (xy[:, 0] < 5.0)).any()
+    every = wall_faces(grid.occupied_mask(), grid.free_mask(), grid.resolution, PARAMS)
+    assert every.sum() == grid.occupied_mask().sum() and (walls <= every).all()
+    grid.log_odds[grid.log_odds > 0] = -2.0  # no wall: no doorway, no label wall
+    assert not label_walls(grid.occupied_mask(), grid.free_mask(), grid.resolution, PARAMS).any()
+
+
+def test_a_gap_across_unseen_space_or_as_wide_as_a_corridor_is_no_doorway():
+    from sim.navigation.frontier import label_walls
+
+    grid = door_grid()
+    rows = grid.world_to_cell(np.array([[4.5, 2.05], [4.5, 2.15]]))[:, 0]
+    grid.log_odds[rows, 44:46] = 0.0  # the doorway's middle unseen: its width is not known
+    assert not label_walls(grid.occupied_mask(), grid.free_mask(), grid.resolution, PARAMS).any()
+    wide = door_grid()
+    wide.log_odds[rows, 35:60] = -2.0  # a 2.5 m gap: the end of a corridor, not a door
+    assert not label_walls(wide.occupied_mask(), wide.free_mask(), wide.resolution, PARAMS).any()
+
+
+def test_a_look_reads_a_wall_only_within_the_reading_cone():
+    from sim.navigation.frontier import look, wall_normals
+
+    grid = door_grid()
+    occupied = grid.occupied_mask()
+    rows, cols = np.nonzero(occupied)
+    normals = wall_normals(occupied, rows, cols)
+    y = grid.cell_to_world(np.stack([rows, cols], axis=1))[:, 1]
+    assert np.allclose(normals[y < 2.1], [0.0, -1.0]) or (np.abs(normals[y < 2.1][:, 1] + 1) < 0.3).all()
+    assert (normals[y > 2.1][:, 1] > 0.7).all()  # the upper face looks up, into the room
+    covered = np.zeros(grid.shape, dtype=bool)
+    look(grid, covered, np.array([2.0, 1.0]), PARAMS)  # 1.05 m below the wall's face
+    read = grid.cell_to_world(np.argwhere(covered & occupied))
+    half = 1.05 * np.tan(np.radians(PARAMS.look_cone_deg))
+    assert np.all(np.abs(read[:, 0] - 2.0) <= half + 0.1) and np.all(read[:, 1] < 2.1)
+    assert read[:, 0].min() < 2.0 - half + 0.3 and read[:, 0].max() > 2.0 + half - 0.3
+    assert covered[tuple(grid.world_to_cell(np.array([2.0, 0.5]))[0])]  # open floor in sight is marked too
+
+
+def test_unread_label_walls_draw_the_search_until_looked_at():
+    from dataclasses import replace
+
+    from sim.navigation.frontier import look
+
+    grid = door_grid()  # everything mapped: only walls not yet looked at can be frontiers
+    covered = np.zeros(grid.shape, dtype=bool)
+    assert nearest_frontier(grid, np.array([8.0, 1.0]), 0.38, PARAMS) is None  # no mask: nothing unseen
+    target = nearest_frontier(grid, np.array([8.0, 1.0]), 0.38, PARAMS, covered=covered)
+    assert target is not None and 2.4 < target[0] < 6.6  # within face_reach_m of the walls by the doorway
+    for x in (3.5, 4.5, 5.5):  # walk past the doorway on both sides, 1 m from the wall
+        look(grid, covered, np.array([x, 1.0]), PARAMS)
+        look(grid, covered, np.array([x, 3.2]), PARAMS)
+    assert nearest_frontier(grid, np.array([8.0, 1.0]), 0.38, PARAMS, covered=covered) is None
+    every = replace(PARAMS, walls="all")  # the second pass: the rest of the wall, not yet looked at
+    assert nearest_frontier(grid, np.array([8.0, 1.0]), 0.38, every, covered=covered) is not None
+
+
+def test_a_wall_not_yet_looked_at_draws_the_search_to_its_own_side_only():
+    from sim.navigation.frontier import look
+
+    grid = door_grid()
+    covered = np.zeros(grid.shape, dtype=bool)
+    for x in (3.5, 4.5, 5.5):  # the corridor side looked at; the room side (y > 2.2 m) not
+        look(grid, covered, np.array([x, 1.0]), PARAMS)
+    frontier, _ = frontier_mask(grid, 0.38, PARAMS, covered)
+    ys = grid.cell_to_world(np.argwhere(frontier))[:, 1]
+    assert ys.size and (ys > 2.2).all()  # in the room, in front of the faces still to read
+
+
+def test_only_the_approach_side_of_a_doorway_must_be_looked_at():
+    from sim.navigation.frontier import label_walls
+
+    grid = door_grid()  # corridor below y = 2 m (no doorway from the start), room above (through one)
+    doors = np.where(grid.cell_to_world(np.argwhere(np.ones(grid.shape, dtype=bool)))[:, 1] > 2.1, 1.0, 0.0)
+    doors = doors.reshape(grid.shape)
+    walls = label_walls(grid.occupied_mask(), grid.free_mask(), grid.resolution, PARAMS, doors)
+    ys = grid.cell_to_world(np.argwhere(walls))[:, 1]
+    assert walls.sum() == 16 and np.allclose(ys, 2.05)  # the corridor's face only: the room's carries no label
+    walls = label_walls(grid.occupied_mask(), grid.free_mask(), grid.resolution, PARAMS, 1.0 - doors)
+    assert np.allclose(grid.cell_to_world(np.argwhere(walls))[:, 1], 2.15)  # approached from the room instead
+
+
+def test_door_counts_count_the_doorways_from_the_start():
+    from sim.navigation.routes import door_counts
+
+    grid = door_grid()
+    doors = door_counts(grid, np.array([2.0, 1.0]))
+    at = lambda x, y: float(doors[tuple(grid.world_to_cell(np.array([x, y]))[0])])  # noqa: E731
+    assert at(8.0, 1.0) < 0.2 and 0.7 < at(4.5, 4.0) < 1.5  # the corridor, and the room through the doorway
