@@ -3,24 +3,17 @@
 Frames: world frame, metres. A frontier cell is a cell the robot can stand in
 (seen free, more than its radius from any seen obstacle) within
 ``FrontierParams.reach_m`` of unseen space. The laser sees 8 m but a label is
-read only within 4 m and within 45 degrees of its face's normal, so a searcher
-for labels also asks to have *looked at* the walls where labels hang: beside
-doorways, on the side a doorway is approached from (:func:`label_walls`,
-:func:`approach_side`). A look (:func:`look`) marks a wall cell in a
-``covered`` mask only when it is within ``look_radius_m`` in line of sight and
-seen within ``look_cone_deg`` of the wall's normal, as a label there would be
-read; cells of such walls not yet covered draw the robot to stand in front of
-them (``face_reach_m``). Open floor carries no labels: once mapped it is done
-with. Without the mask, unseen means unknown on the occupancy grid. Frontier
-cells are grouped 8-connected and groups smaller than ``min_size_m`` (specks
-between laser beams) are dropped. Distances are path lengths through passable
-seen space (scikit-image's minimum-cost path, 8-connected), never straight
-lines.
+read only within 4 m, so a searcher for labels counts space as seen only once
+it was *looked at*: known on the occupancy grid and within ``look_radius_m``
+in line of sight of the robot (:func:`look`, a ``covered`` mask); without that
+mask, unseen means unknown on the occupancy grid. Frontier cells are grouped
+8-connected and groups smaller than ``min_size_m`` (specks between laser
+beams) are dropped. Distances are path lengths through passable seen space
+(scikit-image's minimum-cost path, 8-connected), never straight lines.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -49,24 +42,6 @@ class FrontierParams:
     # m; cells this close in line of sight count as looked at: inside the 4 m reading range (geometric
     # perception, the oracle), with a margin for labels seen off their normal
     look_radius_m: float = 3.0
-    # deg; a wall cell counts as looked at only when seen this close to its normal: inside the 45 degree
-    # reading cone about a label's face (geometric perception, the oracle), with a margin for the estimated normal
-    look_cone_deg: float = 40.0
-    door_width_m: float = 1.3  # m; gaps in walls narrower than this are doorways (doors ~1 m, corridors >= 1.8 m)
-    min_door_m: float = 0.6  # m; narrower gaps are cracks between mapped specks, not doorways
-    # m from a doorway's cells where a label may hang: a label's centre is 0.85 m from its door's centre, so
-    # 0.35 m from the jamb, plus half a 0.25 m tag and a margin
-    label_reach_m: float = 0.8
-    # m; standing cells from half this to this far out along the normal of a wall not yet looked at are on the
-    # frontier: past the robot's radius (0.38 m) and inside a 1.8 m corridor's far half, where it is read head-on
-    face_reach_m: float = 1.0
-    # which walls must be looked at: "labels" (beside doorways, where the convention hangs labels) or "all"
-    # (every wall face: the search's second pass, for labels hung elsewhere)
-    walls: str = "labels"
-    # m out from a wall face, on both sides, where the doorways crossed to get there are compared (past the
-    # robot's radius, 0.38 m, so the search's cells there are passable; inside a 1.8 m corridor)
-    side_m: float = 0.7
-    side_slack: float = 0.5  # doorways; a face is on the approach side unless its side lies half a doorway deeper
     look_every_m: float = 0.1  # m the robot moves between looks (a look is all round; the map grows in between)
     look_rays: int = 180  # rays cast over the grid for :func:`look` (2 degrees apart: 10 cm apart at 3 m)
 
@@ -81,10 +56,9 @@ class Frontiers:
 
 def look(grid: OccupancyGrid, covered: np.ndarray, robot_xy: np.ndarray, params: FrontierParams,
          rays: np.ndarray | None = None) -> None:
-    """Mark in ``covered`` (bool, the grid's shape) what a look from ``robot_xy`` (m) reads: the known free
-    cells within ``look_radius_m`` in line of sight over the grid (a ray stops at the first occupied cell), and
-    that first occupied cell when the ray meets the wall within ``look_cone_deg`` of its normal (a label there
-    would be read); ``rays``: :func:`look_rays` for this grid when already at hand."""
+    """Mark in ``covered`` (bool, the grid's shape) the known cells within ``look_radius_m`` of ``robot_xy`` (m)
+    in line of sight over the grid (a ray stops at the first occupied cell, which it marks); ``rays``:
+    :func:`look_rays` for this grid when already at hand."""
     offsets = look_rays(grid, params) if rays is None else rays
     shape = offsets.shape[1:]  # (rays, samples)
     rc = grid.world_to_cell(np.asarray(robot_xy, dtype=float)[:2] + offsets.reshape(2, -1).T)
@@ -93,132 +67,11 @@ def look(grid: OccupancyGrid, covered: np.ndarray, robot_xy: np.ndarray, params:
     values = np.zeros(shape, dtype=np.float32)  # outside the grid: unknown
     values[inside] = grid.log_odds[row[inside], col[inside]]
     occupied = values > grid.params.occupied_threshold
-    free = values < grid.params.free_threshold
+    known = occupied | (values < grid.params.free_threshold)
     # visible: no occupied sample before this one along the ray (the first occupied one is visible)
     blocked_before = np.cumsum(occupied, axis=1) - occupied > 0
-    seen_free = ~blocked_before & inside & free
-    covered[row[seen_free], col[seen_free]] = True
-    hit = ~blocked_before & inside & occupied
-    ray, sample = np.nonzero(hit)
-    if ray.size == 0:
-        return
-    r, c = row[ray, sample], col[ray, sample]
-    normal = wall_normals(grid.occupied_mask(), r, c)
-    angle = np.arctan2(offsets[1, ray, -1], offsets[0, ray, -1])  # the ray's direction, world frame
-    facing = -(normal[:, 0] * np.cos(angle) + normal[:, 1] * np.sin(angle))  # cos of the incidence
-    flat = np.hypot(normal[:, 0], normal[:, 1]) == 0  # no wall direction to judge by (a lone cell)
-    read = flat | (facing >= math.cos(math.radians(params.look_cone_deg)))
-    covered[r[read], c[read]] = True
-
-
-def wall_normals(occupied: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-    """(N, 2) unit normals (world frame, pointing out of the wall into free space; zero where the 3 x 3
-    neighbourhood gives no direction) of the occupied cells ``(rows, cols)``, from a Sobel gradient."""
-    padded = np.pad(occupied, 1).astype(float)
-    r, c = rows + 1, cols + 1
-    weights = (1.0, 2.0, 1.0)
-    # gradient of occupancy along +col (world +x) and along +row (world -y)
-    g_col = sum(w * (padded[r + d, c + 1] - padded[r + d, c - 1]) for w, d in zip(weights, (-1, 0, 1)))
-    g_row = sum(w * (padded[r + 1, c + d] - padded[r - 1, c + d]) for w, d in zip(weights, (-1, 0, 1)))
-    normal = np.stack([-g_col, g_row], axis=1)  # down the gradient, into free space; rows run down the world's y
-    length = np.hypot(normal[:, 0], normal[:, 1])
-    return np.where(length[:, None] > 0, normal / np.maximum(length, 1e-12)[:, None], 0.0)
-
-
-def label_walls(occupied: np.ndarray, free: np.ndarray, resolution_m: float, params: FrontierParams,
-                doors: np.ndarray | None = None) -> np.ndarray:
-    """Bool (rows, cols): the faces of walls where a label may hang, by the convention of ``worlds/README.md``
-    (beside a doorway, facing the space it is read from): occupied cells next to open free space (not the
-    doorway itself) within ``label_reach_m`` of a doorway cell.
-
-    A doorway cell is a free cell in a gap between walls, along a row or a column, at least ``min_door_m`` and
-    narrower than ``door_width_m`` (doors are ~1 m, corridors 1.8 m and wider); gaps are measured between
-    occupied cells, so a gap that unknown space interrupts is none."""
-    door = np.zeros(occupied.shape, dtype=bool)
-    for axis in (0, 1):
-        gap = _gap_cells(occupied, axis) * resolution_m
-        gap_ok = (gap >= params.min_door_m) & (gap < params.door_width_m)
-        door |= free & gap_ok & _unbroken(free | occupied, occupied, axis)
-    if not door.any():
-        return np.zeros(occupied.shape, dtype=bool)
-    reach = ndimage.distance_transform_edt(~door) * resolution_m <= params.label_reach_m
-    cross = ndimage.generate_binary_structure(2, 1)
-    walls = occupied & reach & ndimage.binary_dilation(free & ~door, structure=cross)
-    return walls if doors is None else walls & approach_side(walls, occupied, doors, resolution_m, params)
-
-
-def approach_side(walls: np.ndarray, occupied: np.ndarray, doors: np.ndarray, resolution_m: float,
-                  params: FrontierParams) -> np.ndarray:
-    """Bool (rows, cols): the wall cells of ``walls`` whose face is on the side a doorway is approached from:
-    the space ``side_m`` out along the face's normal is reached through no more doorways (``doors``, per cell,
-    :func:`sim.navigation.routes.door_counts`) than the space as far out behind the wall. A label hangs on that
-    side (``worlds/README.md``): a room's inner faces beside its own door carry none."""
-    rows, cols = np.nonzero(walls)
-    normal = wall_normals(occupied, rows, cols)
-    k = params.side_m / resolution_m
-
-    def doors_at(sign: float) -> np.ndarray:
-        r = np.clip(np.round(rows - sign * normal[:, 1] * k).astype(int), 0, walls.shape[0] - 1)
-        c = np.clip(np.round(cols + sign * normal[:, 0] * k).astype(int), 0, walls.shape[1] - 1)
-        return doors[r, c]
-
-    out = np.zeros(walls.shape, dtype=bool)
-    out[rows, cols] = doors_at(1.0) <= doors_at(-1.0) + params.side_slack
-    return out
-
-
-def in_front(walls: np.ndarray, occupied: np.ndarray, free: np.ndarray, resolution_m: float,
-             params: FrontierParams) -> np.ndarray:
-    """Bool (rows, cols): the free cells along the normals of the wall cells ``walls``, from ``face_reach_m / 2``
-    to ``face_reach_m`` out (where the robot can stand and read them head-on); a normal stops at the first
-    cell not free (a wall is read from its own side, not through it or round a jamb)."""
-    rows, cols = np.nonzero(walls)
-    normal = wall_normals(occupied, rows, cols)
-    out = np.zeros(walls.shape, dtype=bool)
-    steps = np.arange(1, int(np.ceil(params.face_reach_m / resolution_m)) + 1)
-    r = rows[:, None] - np.round(normal[:, 1:2] * steps[None, :]).astype(int)  # rows run down the world's y
-    c = cols[:, None] + np.round(normal[:, 0:1] * steps[None, :]).astype(int)
-    inside = (r >= 0) & (r < walls.shape[0]) & (c >= 0) & (c < walls.shape[1])
-    open_ = np.zeros(r.shape, dtype=bool)
-    open_[inside] = free[r[inside], c[inside]]
-    clear = np.cumprod(open_, axis=1).astype(bool) & (np.hypot(*normal.T) > 0)[:, None]
-    keep = clear & (steps[None, :] * resolution_m >= params.face_reach_m / 2)
-    out[r[keep], c[keep]] = True
-    return out
-
-
-def wall_faces(occupied: np.ndarray, free: np.ndarray, resolution_m: float, params: FrontierParams,
-               doors: np.ndarray | None = None) -> np.ndarray:
-    """Bool (rows, cols): every occupied cell next to free space (the same signature as :func:`label_walls`)."""
-    return occupied & ndimage.binary_dilation(free, structure=ndimage.generate_binary_structure(2, 1))
-
-
-WALLS = {"labels": label_walls, "all": wall_faces}
-"""The walls a search must look at, by :attr:`FrontierParams.walls`."""
-
-
-def _gap_cells(occupied: np.ndarray, axis: int) -> np.ndarray:
-    """Per cell, the free run (cells) between the nearest occupied cells before and after it along ``axis``;
-    inf where either side has none."""
-    n = occupied.shape[axis]
-    index = np.arange(n, dtype=float).reshape((-1, 1) if axis == 0 else (1, -1))
-    before = np.maximum.accumulate(np.where(occupied, index, -np.inf), axis=axis)
-    after = np.flip(np.minimum.accumulate(np.flip(np.where(occupied, index, np.inf), axis=axis), axis=axis),
-                    axis=axis)
-    return after - before - 1
-
-
-def _unbroken(known: np.ndarray, occupied: np.ndarray, axis: int) -> np.ndarray:
-    """Per cell, whether every cell from the nearest occupied cell before it to the nearest after it along
-    ``axis`` is known (a gap measured across unseen space is not a doorway)."""
-    unknown_run = np.cumsum(~known, axis=axis)
-    n = occupied.shape[axis]
-    index = np.arange(n).reshape((-1, 1) if axis == 0 else (1, -1))
-    shape_index = np.broadcast_to(index, occupied.shape)
-    before = np.maximum.accumulate(np.where(occupied, shape_index, 0), axis=axis)
-    after = np.flip(np.minimum.accumulate(np.flip(np.where(occupied, shape_index, n - 1), axis=axis), axis=axis),
-                    axis=axis)
-    return np.take_along_axis(unknown_run, after, axis=axis) == np.take_along_axis(unknown_run, before, axis=axis)
+    mark = ~blocked_before & inside & known
+    covered[row[mark], col[mark]] = True
 
 
 def look_rays(grid: OccupancyGrid, params: FrontierParams) -> np.ndarray:
@@ -254,10 +107,8 @@ class LookedAt:
 
 
 def frontier_mask(grid: OccupancyGrid, robot_radius_m: float, params: FrontierParams,
-                  covered: np.ndarray | None = None, doors: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """(frontier cells, passable cells), both bool (rows, cols); ``covered``: cells looked at (see :func:`look`);
-    ``doors``: doorways crossed to each cell from the start (:func:`sim.navigation.routes.door_counts`), which
-    keeps the walls to look at to their approach side (:func:`approach_side`).
+                  covered: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(frontier cells, passable cells), both bool (rows, cols); ``covered``: cells looked at (see :func:`look`).
 
     Worked out on the known cells' bounding box with a margin (:func:`known_box`): both masks are empty
     farther out, and every step within looks no farther than the margin (the clearance is wanted only up to
@@ -268,8 +119,8 @@ def frontier_mask(grid: OccupancyGrid, robot_radius_m: float, params: FrontierPa
         return frontier, passable
     rows, cols = box
     window = _window(grid, rows.start, rows.stop, cols.start, cols.stop)
-    frontier[box], passable[box] = _frontier_mask(window, robot_radius_m, params, _cut(covered, box),
-                                                  _cut(doors, box))
+    frontier[box], passable[box] = _frontier_mask(window, robot_radius_m, params,
+                                                  None if covered is None else covered[box])
     return frontier, passable
 
 
@@ -296,12 +147,8 @@ def _reach_cells(grid: OccupancyGrid, params: FrontierParams) -> int:
     return max(1, int(round(params.reach_m / grid.resolution)))
 
 
-def _cut(cells: np.ndarray | None, box: tuple[slice, slice]) -> np.ndarray | None:
-    return None if cells is None else cells[box]
-
-
 def _frontier_mask(grid: OccupancyGrid, robot_radius_m: float, params: FrontierParams,
-                   covered: np.ndarray | None, doors: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+                   covered: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
     """:func:`frontier_mask` over every cell of ``grid``."""
     filled = filled_free(grid, params.fill_holes_cells)
     # Clearance (m) exact up to just past the robot's radius, inf beyond: all that passability asks of it.
@@ -310,12 +157,9 @@ def _frontier_mask(grid: OccupancyGrid, robot_radius_m: float, params: FrontierP
     passable = seen_passable(grid, clearance, robot_radius_m, params.fill_holes_cells, filled)
     occupied = grid.occupied_mask()
     unknown = ~(grid.free_mask() | filled) & ~occupied  # the closing fills; never erodes
-    near_unknown = ndimage.binary_dilation(unknown, structure=_EIGHT, iterations=_reach_cells(grid, params))
     if covered is not None:
-        free = grid.free_mask()
-        unread = WALLS[params.walls](occupied, free, grid.resolution, params, doors) & ~covered
-        if unread.any():
-            near_unknown |= in_front(unread, occupied, free, grid.resolution, params)
+        unknown |= ~covered & ~occupied
+    near_unknown = ndimage.binary_dilation(unknown, structure=_EIGHT, iterations=_reach_cells(grid, params))
     frontier = passable & near_unknown
     labels, count = ndimage.label(frontier, structure=_EIGHT)
     if count:
@@ -331,11 +175,10 @@ def _frontier_mask(grid: OccupancyGrid, robot_radius_m: float, params: FrontierP
 
 
 def find_frontiers(grid: OccupancyGrid, robot_xy: np.ndarray, robot_radius_m: float,
-                   params: FrontierParams, covered: np.ndarray | None = None,
-                   doors: np.ndarray | None = None) -> Frontiers:
+                   params: FrontierParams, covered: np.ndarray | None = None) -> Frontiers:
     """Frontier cells and path distances from ``robot_xy`` (m) through passable seen space (searched on the
     passable cells' bounding box: paths never leave it)."""
-    frontier, passable = frontier_mask(grid, robot_radius_m, params, covered, doors)
+    frontier, passable = frontier_mask(grid, robot_radius_m, params, covered)
     distance = np.full(grid.shape, np.inf)
     start = grid.world_to_cell(np.asarray(robot_xy, dtype=float))[0]
     if not grid.in_bounds(start[None])[0]:
@@ -359,13 +202,12 @@ def find_frontiers(grid: OccupancyGrid, robot_xy: np.ndarray, robot_radius_m: fl
 
 def nearest_frontier(grid: OccupancyGrid, robot_xy: np.ndarray, robot_radius_m: float, params: FrontierParams,
                      visited: list[np.ndarray] | None = None, covered: np.ndarray | None = None,
-                     doors: np.ndarray | None = None,
                      penalty_m: np.ndarray | None = None) -> np.ndarray | None:
     """The reachable frontier cell (m) nearest the robot by path, away from ``visited``; None if none is left.
 
     ``penalty_m`` (the grid's shape, m) is added to each cell's path length: a guided search's cost of
     going where the cues say the goal is unlikely."""
-    found = find_frontiers(grid, robot_xy, robot_radius_m, params, covered, doors)
+    found = find_frontiers(grid, robot_xy, robot_radius_m, params, covered)
     candidates = found.mask & np.isfinite(found.distance_m) & (found.distance_m >= params.min_distance_m)
     cells = np.argwhere(candidates)
     if cells.size == 0:
@@ -385,8 +227,7 @@ def nearest_frontier(grid: OccupancyGrid, robot_xy: np.ndarray, robot_radius_m: 
 
 
 def still_frontier(grid: OccupancyGrid, target_xy: np.ndarray, robot_radius_m: float, params: FrontierParams,
-                   covered: np.ndarray | None = None, margin_m: float = 2.0,
-                   doors: np.ndarray | None = None) -> bool:
+                   covered: np.ndarray | None = None, margin_m: float = 2.0) -> bool:
     """Whether a frontier cell lies within ``reach_m`` plus one cell of ``target_xy`` (m).
 
     Judged on a window of the grid ``margin_m`` around the target (clearances and frontier groups
@@ -400,8 +241,7 @@ def still_frontier(grid: OccupancyGrid, target_xy: np.ndarray, robot_radius_m: f
     if r0 >= r1 or c0 >= c1:
         return False
     window = _window(grid, r0, r1, c0, c1)
-    box = (slice(r0, r1), slice(c0, c1))
-    frontier, _ = frontier_mask(window, robot_radius_m, params, _cut(covered, box), _cut(doors, box))
+    frontier, _ = frontier_mask(window, robot_radius_m, params, None if covered is None else covered[r0:r1, c0:c1])
     reach = int(np.ceil(params.reach_m / grid.resolution)) + 1
     local = rc - [r0, c0]
     near = frontier[max(0, local[0] - reach):local[0] + reach + 1, max(0, local[1] - reach):local[1] + reach + 1]

@@ -30,22 +30,14 @@ import numpy as np
 
 from abstract_map.clauses import Locational
 from abstract_map.model import SettleReport, imagined_positions
-from sim.mapping.occupancy import OccupancyGrid, unpool_cells
+from sim.mapping.occupancy import OccupancyGrid
 from sim.navigation.belief import Belief, BeliefParams, SweptSpace, cue_mass, goal_belief, goal_sigma
 from sim.navigation.follower import FollowerParams, PathFollower, Recovery, RecoveryParams, StuckDetector, StuckParams
 from sim.navigation.frontier import FrontierParams, LookedAt, nearest_frontier, still_frontier
 from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
 from sim.navigation.planner import Plan, PlannerParams
 from sim.navigation.replanner import Replanner, ReplanParams
-from sim.navigation.routes import (
-    Arrow,
-    GuideParams,
-    PathSearches,
-    RouteParams,
-    depth_weight,
-    door_counts,
-    route_likelihood,
-)
+from sim.navigation.routes import Arrow, GuideParams, PathSearches, RouteParams, door_depth_weight, route_likelihood
 from sim.navigation.targeting import Target, TargetParams, choose_target
 from sim.navigation.viewpoints import ViewpointParams, Viewpoints, score_viewpoints, travel_costs
 from sim.perception.sighting import Sighting
@@ -138,7 +130,6 @@ class AbstractMapPolicy:
         self.gave_up = ""
         self.start = np.asarray(start, dtype=float)
         self.depth = np.ones(1)  # door-depth weight per grid cell (sim.navigation.routes), set with the belief
-        self.doors: np.ndarray | None = None  # doorways crossed from the start per grid cell, set with the depth
         self.evidence: np.ndarray | None = None  # depth x route likelihood, per grid cell
         self.evidence_key: tuple[Arrow, ...] = ()
         self.evidence_at = -float("inf")
@@ -193,9 +184,7 @@ class AbstractMapPolicy:
         key = tuple(arrows)
         if self.evidence is None or key != self.evidence_key or self.now - self.evidence_at >= \
                 self.params.routes.evidence_every_s:
-            coarse = door_counts(grid, self.start[:2], self.params.routes, self.searches, fine=False)
-            self.depth = depth_weight(coarse, grid, self.params.routes)
-            self.doors = unpool_cells(coarse, max(1, self.params.routes.depth_pool), grid.shape)
+            self.depth = door_depth_weight(grid, self.start[:2], self.params.routes, self.searches)
             likelihood = route_likelihood(grid, arrows, self.params.routes, self.searches)
             self.evidence = self.depth if likelihood is None else self.depth * likelihood
             self.evidence_key, self.evidence_at = key, self.now
@@ -241,24 +230,15 @@ class FrontierSearch:
     """The loop every frontier search shares: look, keep the target while it is still on a frontier, choose
     afresh when it is reached or gone (and every ``rechoose_s``), drive to it.
 
-    Unseen space draws the robot, and so do walls where a label may hang that
-    were not yet looked at from within reading range and the reading cone
-    (:func:`sim.navigation.frontier.look`): first the walls beside doorways on
-    the side they are approached from (doorways crossed from the start,
-    :func:`sim.navigation.routes.door_counts`), where the convention hangs
-    labels; when none is left, every wall, once and for good. Near its target
-    the robot keeps it; a target stood on (``arrive_m``) or found unreachable is
-    never chosen again, read or not. :attr:`exhausted` turns true when no
-    frontier is left in either pass.
+    Space counts as explored once looked at from within reading range
+    (:func:`sim.navigation.frontier.look`), not merely swept by the 8 m laser. A
+    reached or unreachable target is never chosen again. :attr:`exhausted`
+    turns true when no frontier is left.
     """
 
-    def __init__(self, params: PolicyParams, drive: DriveStack, frontier: FrontierParams, start_xy: np.ndarray,
+    def __init__(self, params: PolicyParams, drive: DriveStack, frontier: FrontierParams,
                  rechoose_s: float = math.inf) -> None:
         self.params, self.drive, self.frontier, self.rechoose_s = params, drive, frontier, rechoose_s
-        self.start_xy = np.asarray(start_xy, dtype=float)[:2]
-        self.searches = PathSearches()  # the door counts' path searches, run again only on a changed map
-        self.doors: np.ndarray | None = None  # doorways crossed from the start, per grid cell
-        self.doors_at = -float("inf")
         self.target: np.ndarray | None = None
         self.chosen_at = self.checked_at = -float("inf")
         self.visited: list[np.ndarray] = []
@@ -266,31 +246,18 @@ class FrontierSearch:
         self.exhausted = False
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float, rng: np.random.Generator,
-                penalty: Callable[[], np.ndarray | None] = lambda: None,
-                doors: Callable[[], np.ndarray | None] | None = None) -> tuple[float, float]:
+                penalty: Callable[[], np.ndarray | None] = lambda: None) -> tuple[float, float]:
         """The wheel command (m/s, rad/s) towards the frontier of least path length plus ``penalty()`` (m per
-        grid cell, or None); ``doors()``: doorways crossed from the start per grid cell, when the caller keeps
-        them (else worked out here)."""
+        grid cell, or None)."""
         radius = self.params.planner.robot_radius_m
-        robot = np.array(pose[:2])
-        covered = self.looked.update(grid, robot, self.frontier)
-        door_cells = (lambda: self._doors(t_s, grid)) if doors is None else doors  # asked only when choosing
-        gap = math.inf if self.target is None else float(np.hypot(*(self.target - robot)))
-        if gap < self.params.navigator.arrive_m:
-            self.visited.append(self.target)  # stood on it: done with, read or not
-            self.target, gap = None, math.inf
+        covered = self.looked.update(grid, np.array(pose[:2]), self.frontier)
         if self.target is not None and t_s - self.checked_at >= self.frontier.recheck_s:
             self.checked_at = t_s
-            if not still_frontier(grid, self.target, radius, self.frontier, covered, doors=door_cells()):
+            if not still_frontier(grid, self.target, radius, self.frontier, covered):
                 self.target = None
-        # near its target the robot goes on to it: a new choice would skip it as too near
-        if self.target is None or (t_s - self.chosen_at >= self.rechoose_s and gap >= self.frontier.min_distance_m):
-            self.target = nearest_frontier(grid, robot, radius, self.frontier, self.visited, covered,
-                                           door_cells(), penalty_m=penalty())
-            if self.target is None and self.frontier.walls != "all":
-                self.frontier = replace(self.frontier, walls="all")  # labels hung elsewhere: every wall, for good
-                self.target = nearest_frontier(grid, robot, radius, self.frontier, self.visited, covered,
-                                               door_cells(), penalty_m=penalty())
+        if self.target is None or t_s - self.chosen_at >= self.rechoose_s:
+            self.target = nearest_frontier(grid, np.array(pose[:2]), radius, self.frontier, self.visited, covered,
+                                           penalty_m=penalty())
             self.chosen_at = self.checked_at = t_s
             self.drive.replanner.request()
             if self.target is None:
@@ -301,14 +268,6 @@ class FrontierSearch:
             self.visited.append(self.target)
             self.target = None
         return v, w
-
-    def _doors(self, t_s: float, grid: OccupancyGrid) -> np.ndarray | None:
-        """Doorways crossed from the start to each grid cell, worked out again every ``evidence_every_s``."""
-        if self.doors is None or self.doors.shape != grid.shape or \
-                t_s - self.doors_at >= self.params.routes.evidence_every_s:
-            self.doors = door_counts(grid, self.start_xy, self.params.routes, self.searches)
-            self.doors_at = t_s
-        return self.doors
 
     def shown(self) -> tuple[float, float]:
         """The target (m) for drawing; NaN when there is none."""
@@ -328,7 +287,7 @@ class FrontierPolicy:
                  frontier: FrontierParams | None = None) -> None:
         self.params = params
         self.drive = DriveStack(params)
-        self.search = FrontierSearch(params, self.drive, frontier or FrontierParams(), np.asarray(start)[:2])
+        self.search = FrontierSearch(params, self.drive, frontier or FrontierParams())
         self.cues: list[CueEvent] = []  # reads no sign
         self.gave_up = ""
 
@@ -447,7 +406,7 @@ class GuidedPolicy(AbstractMapPolicy):
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
         super().__init__(world, goal, start, params)
         frontier = replace(FrontierParams(), min_distance_m=params.guide.min_target_m)
-        self.search = FrontierSearch(params, self.drive, frontier, self.start[:2], params.guide.rechoose_s)
+        self.search = FrontierSearch(params, self.drive, frontier, params.guide.rechoose_s)
         self.penalty: tuple[tuple, np.ndarray] | None = None  # the latest penalty and what it was worked out from
 
     def forget_target(self) -> None:
@@ -471,16 +430,10 @@ class GuidedPolicy(AbstractMapPolicy):
         self.penalty = (key, penalty)
         return penalty
 
-    def _doors(self, grid: OccupancyGrid) -> np.ndarray | None:
-        """Doorways crossed from the start per grid cell, refreshed with the evidence."""
-        self._evidence(grid)
-        return self.doors
-
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:
         self.now = t_s
-        v, w = self.search.command(t_s, pose, grid, tick_s, rng, penalty=lambda: self._penalty(grid),
-                                   doors=lambda: self._doors(grid))
+        v, w = self.search.command(t_s, pose, grid, tick_s, rng, penalty=lambda: self._penalty(grid))
         if self.search.exhausted:
             self.gave_up = NO_FRONTIER
         return v, w

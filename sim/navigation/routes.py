@@ -155,23 +155,6 @@ def door_depth_weight(grid: OccupancyGrid, start_xy: np.ndarray, params: RoutePa
 
     Searched on cells ``depth_pool`` times coarser, each as narrow as its narrowest fine cell. ``searches``:
     path searches kept from earlier calls (the same answer, sooner)."""
-    return depth_weight(door_counts(grid, start_xy, params, searches, fine=False), grid, params)
-
-
-def depth_weight(doors: np.ndarray, grid: OccupancyGrid, params: RouteParams = RouteParams()) -> np.ndarray:
-    """:func:`door_depth_weight` from the door counts on the search's coarse cells (:func:`door_counts` with
-    ``fine=False``)."""
-    weight = params.room_weight ** doors
-    reach = max(1, int(round(params.front_m / (grid.resolution * max(1, params.depth_pool)))))
-    front = ndimage.maximum_filter(weight, size=2 * reach + 1, mode="nearest")
-    return unpool_cells(front, max(1, params.depth_pool), grid.shape)
-
-
-def door_counts(grid: OccupancyGrid, start_xy: np.ndarray, params: RouteParams = RouteParams(),
-                searches: PathSearches | None = None, *, fine: bool = True) -> np.ndarray:
-    """Per cell, the doorways (passages narrower than ``door_width_m``) a route from ``start_xy`` (m) crosses
-    to reach it, in [0, 6] (6 where no route is mapped; unseen space counts as open, mapped walls block); on
-    the grid's cells (``fine``) or on the search's ``depth_pool`` times coarser ones."""
     searches = PathSearches() if searches is None else searches
     pool = max(1, params.depth_pool)
     res = grid.resolution * pool
@@ -191,5 +174,7 @@ def door_counts(grid: OccupancyGrid, start_xy: np.ndarray, params: RouteParams =
     plain = searches.lengths("plain", np.where(passable, 1.0, np.inf), seed) * res
     with np.errstate(invalid="ignore"):
         doors = np.where(np.isfinite(cost) & np.isfinite(plain), (cost - plain) / params.door_cost_m, 6.0)
-    doors = np.clip(doors, 0.0, 6.0)
-    return unpool_cells(doors, pool, grid.shape) if fine else doors
+    weight = params.room_weight ** np.clip(doors, 0.0, 6.0)
+    reach = max(1, int(round(params.front_m / res)))
+    front = ndimage.maximum_filter(weight, size=2 * reach + 1, mode="nearest")
+    return unpool_cells(front, pool, grid.shape)
