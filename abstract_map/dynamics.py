@@ -89,11 +89,11 @@ def angle_lengths(springs: Sequence[Resolved], kind: str, default: float) -> np.
 def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndarray],
            fixed: Mapping[str, np.ndarray], springs: Sequence[Resolved], *,
            expand: Sequence[str], centre: np.ndarray | None, params: DynamicsParams,
-           max_steps: int | None = None, max_s: float | None = None) -> SettleResult:
+           max_steps: int | None = None, deadline: float | None = None) -> SettleResult:
     """Integrate until every free mass has |a| < L_a and |v| < L_v, or a cap: ``max_steps`` steps (default
-    ``params.max_iterations``) or ``max_s`` seconds of wall time (default none), whichever comes first."""
+    ``params.max_iterations``) or the ``time.perf_counter()`` reading ``deadline`` (default none), whichever
+    comes first."""
     step_cap = params.max_iterations if max_steps is None else max_steps
-    deadline = math.inf if max_s is None else time.perf_counter() + max_s
     free = list(positions)
     names = free + list(fixed)
     index = {name: i for i, name in enumerate(names)}
@@ -142,7 +142,7 @@ def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndar
         if iterations >= step_cap:
             stopped_by = "steps"
             break
-        if iterations % _CLOCK_EVERY == 0 and iterations and time.perf_counter() >= deadline:
+        if deadline is not None and iterations % _CLOCK_EVERY == 0 and iterations and time.perf_counter() >= deadline:
             stopped_by = "time"
             break
         # Chipmunk moves bodies (x += v dt) before it applies forces and spring impulses, so

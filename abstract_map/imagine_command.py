@@ -22,6 +22,7 @@ from typing import Any
 from . import errors
 from .cli import distinct_outputs, output_file
 from .files import write_text_atomic
+from .model import settle_caps
 from .scenario import load_scenario, replay
 
 PLOT_SUFFIXES = ("png", "pdf", "svg", "jpg", "jpeg")
@@ -49,10 +50,7 @@ def run(args: argparse.Namespace) -> int:
         output_file("--save-model", args.save_model)
     distinct_outputs(scenario=args.scenario, **{"--out": args.out, "--plot": args.plot,
                                                 "--save-model": args.save_model})
-    if args.max_steps is not None:
-        errors.integer("--max-steps", args.max_steps, low=1, high=10**9)
-    if args.max_s is not None:
-        errors.number("--max-s", args.max_s, low=1e-6, high=1e9)
+    settle_caps(args.max_steps, args.max_s, names=("--max-steps", "--max-s"), error=errors.AbstractMapError)
     scenario = load_scenario(args.scenario)
 
     def progress(i: int, n: int, record: dict[str, Any]) -> None:

@@ -381,10 +381,7 @@ class AbstractMap:
         wall time for this call (default none; the clock is read every 16 steps, so a few may run over). A
         capped settle keeps where the masses got to, its report says which cap stopped it, and the next
         settle carries on from there."""
-        if max_steps is not None:
-            max_steps = errors.integer("settle max_steps", max_steps, low=1, high=10**9, error=ModelError)
-        if max_s is not None:
-            max_s = errors.number("settle max_s", max_s, low=1e-6, high=1e9, error=ModelError)
+        max_steps, max_s = settle_caps(max_steps, max_s)
         began = time.perf_counter()
         springs = self.resolved_springs()
         places = self.places()
@@ -402,8 +399,7 @@ class AbstractMap:
         result = run_dynamics({p: self.positions[p] for p in places}, self.velocities,
                               {n: f.xy for n, f in self.fixed.items()}, springs,
                               expand=expand, centre=self.explored_centre, params=self.params.dynamics,
-                              max_steps=max_steps,
-                              max_s=None if max_s is None else max(1e-9, max_s - (time.perf_counter() - began)))
+                              max_steps=max_steps, deadline=None if max_s is None else began + max_s)
         bad = [n for n, xy in result.positions.items() if not np.all(np.abs(xy) <= errors.COORDINATE_LIMIT_M)]
         if bad:  # never expected with checked inputs: refuse rather than hand out NaN
             for name in placed:
@@ -415,6 +411,15 @@ class AbstractMap:
         self.velocities.update(result.velocities)
         return SettleReport(result.settled, result.iterations, time.perf_counter() - began, tuple(new),
                             result.stopped_by)
+
+
+def settle_caps(max_steps: object, max_s: object, *, names: tuple[str, str] = ("settle max_steps", "settle max_s"),
+                error: type[errors.AbstractMapError] = ModelError) -> tuple[int | None, float | None]:
+    """The per-call caps of :meth:`AbstractMap.settle`, checked: ``max_steps`` an integer in [1, 1e9),
+    ``max_s`` seconds in [1e-6, 1e9]; either may be None (no cap of that kind). ``names`` name them in errors."""
+    steps = None if max_steps is None else errors.integer(names[0], max_steps, low=1, high=10**9, error=error)
+    seconds = None if max_s is None else errors.number(names[1], max_s, low=1e-6, high=1e9, error=error)
+    return steps, seconds
 
 
 EXPLORATION_LAWS = {
