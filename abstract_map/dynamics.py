@@ -1,57 +1,42 @@
-"""Algorithm 1 on pymunk: integrate the spring-mass system until it settles.
+"""Algorithm 1 on pymunk, island by island: integrate what a cue disturbs until every mass has settled.
 
-Each settle builds a pymunk space from plain state (positions, velocities,
-springs) in a fixed order, so the model's state is data and the same state
-always settles the same way. One pymunk body per mass: free masses are dynamic
-bodies of the configured mass with infinite moment and a circle of radius
-``min_separation / 2`` (colliding masses bounce); observed tags and the start
-are static bodies. Distance springs are pymunk ``DampedSpring``s; angle
-springs and the expansion force are applied every step from ``forces.py``,
-evaluated where pymunk is about to move each body so they stay in step with
-the springs.
-Viscous friction is pymunk's space damping, exact for linear friction.
+A settle starts from the masses it is told move (new masses, masses still
+moving from a capped settle) and those of the masses it is told to test (the
+ends of springs added, removed or changed) that fail the wake test: the net
+force on them (``forces.py``) would accelerate them at
+``DynamicsParams.wake_acceleration`` or more. Those form an island: a pymunk
+space (``island.py``) in which they move and every mass their springs reach
+is held still where it is. Every ``_EDGE_EVERY`` steps, and whenever the
+island passes Algorithm 1's test (|v| < L_v and |a| < L_a for each of its
+masses), the masses held still at its edge take the wake test, and those that
+fail join it. When none fails and the island is at rest, the settle ends:
+every mass it moved passed Algorithm 1's test, and every mass it left still
+has |v| < L_v and an acceleration below the wake threshold (under L_a). So a
+cue costs time in proportion to what it moves, and a model of any size that
+nothing has disturbed costs nothing.
+
+The same state always settles the same way: islands are built from plain
+data (names, springs, positions, velocities) and every walk over the springs
+follows the model's list of them.
 """
 
 from __future__ import annotations
 
-import math
 import time
-from collections.abc import Mapping, Sequence
+from collections import Counter
+from collections.abc import Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
-import pymunk
-import pymunk.batch
 
-from .forces import ForceField
+from .forces import forces_on
+from .island import Island
 from .params import DynamicsParams
 from .placement import Resolved
 
-_FREE_CATEGORY = 0b1
-_READ = pymunk.batch.BodyFields.POSITION | pymunk.batch.BodyFields.VELOCITY
-
-
-class _BodyState:
-    """Bulk access to every body's position, velocity and force through ``pymunk.batch``."""
-
-    def __init__(self, space: pymunk.Space, n_bodies: int) -> None:
-        self.space, self.n = space, n_bodies
-        self.buffer = pymunk.batch.Buffer()
-        self.forces = np.zeros(n_bodies, dtype=np.complex128)
-        self.force_buffer = pymunk.batch.Buffer()
-        self.force_buffer.set_float_buf(self.forces)
-
-    def read(self) -> tuple[np.ndarray, np.ndarray]:
-        """Positions (m) and velocities (m/s) as complex ``x + iy``, in the order bodies were added."""
-        self.buffer.clear()
-        pymunk.batch.get_space_bodies(self.space, _READ, self.buffer)
-        data = np.frombuffer(self.buffer.float_buf(), dtype=np.complex128).reshape(self.n, 2).copy()
-        return data[:, 0], data[:, 1]
-
-    def write_forces(self, forces: np.ndarray) -> None:
-        """Set every body's force (N, complex) for the next step."""
-        self.forces[:] = forces
-        pymunk.batch.set_space_bodies(self.space, pymunk.batch.BodyFields.FORCE, self.force_buffer)
+_CLOCK_EVERY = 16  # steps between looks at the clock under a time cap (a step is tens of microseconds or more)
+_EDGE_EVERY = 32  # steps between tests of the masses held still at the island's edge, besides one at each rest
 
 
 @dataclass(frozen=True)
@@ -59,109 +44,171 @@ class SettleResult:
     """The outcome of Algorithm 1."""
 
     settled: bool
-    iterations: int
-    positions: dict[str, np.ndarray]  # m, world frame, free masses
-    velocities: dict[str, np.ndarray]  # m/s
+    iterations: int  # steps integrated, all islands together
+    positions: dict[str, np.ndarray]  # m, world frame: the free masses that moved (the final island)
+    velocities: dict[str, np.ndarray]  # m/s, likewise
     stopped_by: str = ""  # why it stopped unsettled: "steps" (the step cap) or "time" (the time cap); "" if settled
+    islands: int = 0  # times masses joined the moving island: 1 + the times masses held still at its edge joined
 
 
-_CLOCK_EVERY = 16  # steps between looks at the clock under a time cap (a step is tens of microseconds or more)
+class SpringIndex:
+    """The springs of a model by the masses they touch, kept up to date cue by cue (:meth:`update`).
+
+    A spring that appears twice counts twice. Every walk over it is in the order of the model's list of
+    springs (:meth:`rank_by`), so the same state gives the same islands however it was reached.
+    """
+
+    def __init__(self, springs: Sequence[Resolved] = ()) -> None:
+        self.count: Counter[Resolved] = Counter()
+        self.touching: dict[str, dict[Resolved, None]] = {}
+        self.rank: dict[Resolved, int] = {}  # each spring's place in the model's list: the order of every walk
+        self.update(springs, ())
+        self.rank_by(springs)
+
+    def rank_by(self, springs: Sequence[Resolved]) -> None:
+        """Walk springs in the order of ``springs`` (the model's list), whatever order they were added in."""
+        self.rank = {s: i for i, s in reversed(list(enumerate(springs)))}
+
+    def update(self, added: Iterable[Resolved], removed: Iterable[Resolved]) -> None:
+        """Add and remove springs (each occurrence once)."""
+        for s in removed:
+            self.count[s] -= 1
+            if self.count[s] <= 0:
+                del self.count[s]
+                for end in s.ends:
+                    self.touching[end].pop(s, None)
+        for s in added:
+            self.count[s] += 1
+            for end in s.ends:
+                self.touching.setdefault(end, {})[s] = None
+
+    def around(self, names: Iterable[str]) -> list[Resolved]:
+        """Every spring touching one of ``names``, once each."""
+        chosen: dict[Resolved, None] = {}
+        for name in names:
+            chosen.update(self.touching.get(name, {}))
+        return sorted(chosen, key=self.rank.__getitem__)
+
+    def length(self, spring: Resolved, default: float) -> float:
+        """``l`` (m) of an angle spring: the natural length of the stiffest distance spring between its pivot
+        and the place it turns (global: reference and figure; relative: vertex and its second place)."""
+        pivot, turned = spring.ends[-2:]
+        best: Resolved | None = None
+        for s in self.touching.get(pivot, {}):
+            if s.kind == "distance" and turned in s.ends and pivot in s.ends and \
+                    (best is None or s.stiffness > best.stiffness):
+                best = s
+        return default if best is None else best.value
 
 
-def _indices(springs: Sequence[Resolved], kind: str, index: Mapping[str, int], width: int) -> tuple[np.ndarray, ...]:
-    chosen = [s for s in springs if s.kind == kind]
-    ends = np.array([[index[e] for e in s.ends] for s in chosen], dtype=int).reshape(-1, width)
-    return (*ends.T, np.array([s.value for s in chosen]), np.array([s.stiffness for s in chosen]))
+class _Positions(dict):  # type: ignore[type-arg]
+    """Complex positions (m) by name, filled from plain ``(x, y)`` mappings when first asked for."""
 
+    def __init__(self, *sources: Mapping[str, Any]) -> None:
+        super().__init__()
+        self.sources = sources
 
-def angle_lengths(springs: Sequence[Resolved], kind: str, default: float) -> np.ndarray:
-    """Per angle spring of ``kind``, the natural length (m) of the stiffest distance spring between its pivot and
-    the place it turns (global: reference and figure; relative: vertex and its second place), or ``default``."""
-    natural: dict[frozenset[str], Resolved] = {}
-    for s in springs:
-        key = frozenset(s.ends)
-        if s.kind == "distance" and (key not in natural or s.stiffness > natural[key].stiffness):
-            natural[key] = s
-    return np.array([natural[key].value if (key := frozenset(s.ends[-2:])) in natural else default
-                     for s in springs if s.kind == kind], dtype=float)
+    def __missing__(self, name: str) -> complex:
+        for source in self.sources:
+            if name in source:
+                x, y = source[name]
+                value = self[name] = complex(float(x), float(y))
+                return value
+        raise KeyError(name)
 
 
 def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndarray],
-           fixed: Mapping[str, np.ndarray], springs: Sequence[Resolved], *,
-           expand: Sequence[str], centre: np.ndarray | None, params: DynamicsParams,
-           max_steps: int | None = None, deadline: float | None = None) -> SettleResult:
-    """Integrate until every free mass has |a| < L_a and |v| < L_v, or a cap: ``max_steps`` steps (default
-    ``params.max_iterations``) or the ``time.perf_counter()`` reading ``deadline`` (default none), whichever
-    comes first."""
+           fixed: Mapping[str, np.ndarray], springs: Sequence[Resolved] | SpringIndex, *,
+           active: Iterable[str], expand: Iterable[str], centre: np.ndarray | None, params: DynamicsParams,
+           tested: Iterable[str] = (), max_steps: int | None = None, deadline: float | None = None) -> SettleResult:
+    """Settle the masses ``active``, those of ``tested`` that fail the acceleration test, and whatever they
+    disturb; every other free mass of ``positions`` is held still until the net force on it would accelerate
+    it at ``params.wake_acceleration`` or more.
+
+    Stops settled, or at a cap: ``max_steps`` steps in all (default ``params.max_iterations``) or the
+    ``time.perf_counter()`` reading ``deadline`` (default none), whichever comes first."""
     step_cap = params.max_iterations if max_steps is None else max_steps
-    free = list(positions)
-    names = free + list(fixed)
-    index = {name: i for i, name in enumerate(names)}
-    space = pymunk.Space()
-    space.damping = math.exp(-params.friction / params.mass)
-    bodies: list[pymunk.Body] = []
-    for name in free:
-        body = pymunk.Body(params.mass, math.inf)
-        body.position = tuple(map(float, positions[name]))
-        body.velocity = tuple(map(float, velocities.get(name, (0.0, 0.0))))
-        shape = pymunk.Circle(body, params.min_separation / 2.0)
-        shape.elasticity = 0.5
-        shape.filter = pymunk.ShapeFilter(categories=_FREE_CATEGORY, mask=_FREE_CATEGORY)
-        space.add(body, shape)
-        bodies.append(body)
-    for name in fixed:
-        body = pymunk.Body(body_type=pymunk.Body.STATIC)
-        body.position = tuple(map(float, fixed[name]))
-        space.add(body)
-        bodies.append(body)
-    for s in springs:
-        if s.kind == "distance":
-            a, b = bodies[index[s.ends[0]]], bodies[index[s.ends[1]]]
-            space.add(pymunk.DampedSpring(a, b, (0, 0), (0, 0), s.value, s.stiffness, 0.0))
-    n_free = len(free)
-    uses_lengths = params.angle_law != "constant"
-    field = ForceField(
-        len(bodies),
-        *_indices(springs, "global_angle", index, 2),
-        *_indices(springs, "relative_angle", index, 3),
-        expand=np.array([index[n] for n in expand if n in index and index[n] < n_free], dtype=int),
-        centre=None if centre is None else complex(float(centre[0]), float(centre[1])),
-        expansion=params.expansion, law=params.expansion_law, core=params.angle_core,
-        angle_law=params.angle_law,  # the lengths below only the potential law uses
-        g_length=angle_lengths(springs, "global_angle", params.angle_length) if uses_lengths else None,
-        r_length=angle_lengths(springs, "relative_angle", params.angle_length) if uses_lengths else None,
-    )
-    state = _BodyState(space, len(bodies))
-    pos, velocity = state.read()
-    if not np.allclose(pos, [complex(*b.position) for b in bodies]):
-        raise RuntimeError("pymunk returned bodies in an unexpected order")
+    index = springs if isinstance(springs, SpringIndex) else SpringIndex(springs)
+    where = _Positions(positions, fixed)
+    speed = _Positions(velocities, _Zero())
+    expand = expand if isinstance(expand, (set, frozenset, dict)) else set(expand)
+    names = list(dict.fromkeys(n for n in active if n in positions))
+    inside = set(names)
+    names += _failing([n for n in dict.fromkeys(tested) if n in positions and n not in inside], index, where,
+                      expand, centre, params)
+    island = Island(index, fixed, expand=expand, centre=centre, params=params)
+    steps, joins, stopped_by = 0, 0, ""
     dv_limit = params.settle_acceleration * params.dt
-    settled, iterations = n_free == 0, 0
-    stopped_by = ""
-    while not settled:
-        if iterations >= step_cap:
-            stopped_by = "steps"
+    joining = names
+    while joining:
+        island.join(joining, where, speed, index.around(joining))
+        joins += 1
+        joining = []
+        z, velocity = island.read()
+        if not np.allclose(z, [where[n] for n in island.names]):
+            raise RuntimeError("pymunk returned bodies in an unexpected order")
+        while True:
+            if steps >= step_cap:
+                stopped_by = "steps"
+                break
+            if deadline is not None and steps % _CLOCK_EVERY == 0 and steps and time.perf_counter() >= deadline:
+                stopped_by = "time"
+                break
+            island.step(z, velocity)
+            steps += 1
+            z, after = island.read()
+            # |v| < L_v and |a| < L_a for every island mass, with a = dv / dt
+            at_rest = bool(np.abs(after).max() < params.settle_velocity
+                           and np.abs(after - velocity).max() < dv_limit)
+            velocity = after
+            if at_rest or steps % _EDGE_EVERY == 0:
+                where.update(zip(island.names, z))
+                speed.update(zip(island.names, velocity))
+                joining = _woken(island.names, index, where, island.expand, centre, params, positions)
+                if joining or at_rest:
+                    break
+        if stopped_by:
             break
-        if deadline is not None and iterations % _CLOCK_EVERY == 0 and iterations and time.perf_counter() >= deadline:
-            stopped_by = "time"
-            break
-        # Chipmunk moves bodies (x += v dt) before it applies forces and spring impulses, so
-        # forces are taken at those positions; a one-step lag would feed energy into the system.
-        ahead = pos + velocity * params.dt
-        force = field(ahead)
-        state.write_forces(force)
-        space.step(params.dt)
-        iterations += 1
-        pos, new_velocity = state.read()
-        dv = new_velocity[:n_free] - velocity[:n_free]
-        velocity = new_velocity
-        # |v| < L_v and |a| < L_a for every free mass, with a = dv / dt
-        settled = bool(np.abs(velocity[:n_free]).max() < params.settle_velocity
-                       and np.abs(dv).max() < dv_limit)
+    z, v = island.read()
+    where.update(zip(island.names, z))
+    speed.update(zip(island.names, v))
     return SettleResult(
-        settled=settled,
-        iterations=iterations,
-        stopped_by=stopped_by,
-        positions={n: np.array([pos[i].real, pos[i].imag]) for i, n in enumerate(free)},
-        velocities={n: np.array([velocity[i].real, velocity[i].imag]) for i, n in enumerate(free)},
+        settled=not stopped_by, iterations=steps, stopped_by=stopped_by, islands=joins,
+        positions={n: np.array([where[n].real, where[n].imag]) for n in island.names},
+        velocities={n: np.array([speed[n].real, speed[n].imag]) for n in island.names},
     )
+
+
+class _Zero:
+    """Every name's velocity (m/s) when none is given: at rest."""
+
+    def __contains__(self, name: object) -> bool:
+        return True
+
+    def __getitem__(self, name: str) -> tuple[float, float]:
+        return 0.0, 0.0
+
+
+def _woken(names: Sequence[str], index: SpringIndex, where: Mapping[str, complex], expanding: Collection[str],
+           centre: np.ndarray | None, params: DynamicsParams, free: Mapping[str, np.ndarray]) -> list[str]:
+    """The free masses held still at the island's edge that fail the acceleration test, in a fixed order."""
+    inside = dict.fromkeys(names)
+    edge = list(dict.fromkeys(e for s in index.around(names) for e in s.ends if e in free and e not in inside))
+    return _failing(edge, index, where, expanding, centre, params)
+
+
+def _failing(names: Sequence[str], index: SpringIndex, where: Mapping[str, complex], expanding: Collection[str],
+             centre: np.ndarray | None, params: DynamicsParams) -> list[str]:
+    """Those of ``names`` (masses held still) on which the net force would accelerate them at
+    ``params.wake_acceleration`` or more, in ``names`` order."""
+    if not names:
+        return []
+    around = [s for s in index.around(names) for _ in range(index.count[s])]
+    force = forces_on(names, around, where, [index.length(s, params.angle_length) if s.kind != "distance" else 0.0
+                                             for s in around],
+                      expand=[e in expanding for e in names],
+                      centre=None if centre is None else complex(float(centre[0]), float(centre[1])),
+                      expansion=params.expansion, law=params.expansion_law, core=params.angle_core,
+                      share=params.angle_core_share)
+    limit = params.wake_acceleration * params.mass
+    return [e for e, f in zip(names, force) if abs(f) >= limit]

@@ -34,6 +34,7 @@ class Hierarchy:
     places: list[str] = field(default_factory=list)  # every place, in document order
 
     def __post_init__(self) -> None:
+        self._cache: dict[str, tuple[tuple[int, int], Any]] = {}  # derived data by the version it was made at
         self._known = set(self.places)
         self._with_children = set(self.parent.values())
         if len(self._known) != len(self.places):
@@ -85,8 +86,23 @@ class Hierarchy:
         parents = set(self.parent.values())
         return [p for p in self.places if p not in parents]
 
+    @property
+    def version(self) -> tuple[int, int]:
+        """Changes whenever the hierarchy does (it only grows: edges and places are never removed)."""
+        return len(self.parent), len(self.places)
+
+    def _cached(self, key: str, make: Any) -> Any:
+        version = self.version
+        hit = self._cache.get(key)
+        if hit is None or hit[0] != version:
+            hit = self._cache[key] = (version, make())
+        return hit[1]
+
     def levels(self) -> dict[str, int]:
-        """Level of every place: leaves 1, a parent one above its highest child."""
+        """Level of every place: leaves 1, a parent one above its highest child (a shared table: do not change)."""
+        return self._cached("levels", self._levels)
+
+    def _levels(self) -> dict[str, int]:
         pending = dict.fromkeys(self.places, 0)  # children not yet levelled
         for parent in self.parent.values():
             pending[parent] += 1
@@ -103,8 +119,9 @@ class Hierarchy:
         return level
 
     def clauses(self) -> list[Relational]:
-        """The hierarchy as "X is in Y" clauses, in document order."""
-        return [Relational("in", c, (self.parent[c],)) for c in self.places if c in self.parent]
+        """The hierarchy as "X is in Y" clauses, in document order (a shared list: do not change)."""
+        return self._cached("clauses", lambda: [Relational("in", c, (self.parent[c],))
+                                                for c in self.places if c in self.parent])
 
     def to_nested(self) -> dict[str, Any]:
         nodes: dict[str, dict[str, Any]] = {p: {} for p in self.places}

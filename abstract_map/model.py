@@ -12,13 +12,18 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Iterable, Mapping
+from collections import Counter
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 from . import errors
 from .clauses import START_ANCHOR, Clause, Locational, Relational, is_anchor, tag_anchor
+from .dynamics import SpringIndex
 from .dynamics import settle as run_dynamics
 from .errors import CueError, ModelError, UnknownPlaceError
 from .grammar import Anchor, parse_cue
@@ -26,12 +31,13 @@ from .hierarchy import Hierarchy
 from .params import STIFFNESS, AbstractMapParams
 from .placement import Resolved, place_new_masses
 from .prepositions import LOCATIONAL, TABLE
-from .scales import ScaleKey, learn_scales, natural_length
-from .springs import Spring, clause_springs, springs_from_clauses
+from .scales import ScaleKey, learn_scales, natural_lengths
+from .springs import Spring, clause_springs
 
 __all__ = ["AbstractMap", "FixedPoint", "Observation", "SettleReport", "UnknownPlaceError", "imagined_positions"]
 
 FIXED_KINDS = ("label", "sign", "start")
+T = TypeVar("T")
 
 
 @dataclass
@@ -60,6 +66,17 @@ class FixedPoint:
 
 
 @dataclass(frozen=True)
+class _LastSettle:
+    """What a settle left for the next to compare with."""
+
+    springs: set[Resolved]
+    count: Counter[Resolved]  # each spring's occurrences, kept only when some spring occurs twice
+    duplicates: int  # occurrences beyond the first, all springs together
+    fixed: dict[str, np.ndarray]  # m, every fixed point
+    moving: list[str]  # places left with |v| >= L_v (by a cap)
+
+
+@dataclass(frozen=True)
 class SettleReport:
     """What one settle did."""
 
@@ -68,6 +85,7 @@ class SettleReport:
     wall_s: float
     new_masses: tuple[str, ...] = ()
     stopped_by: str = ""  # why it stopped unsettled: "steps" (the step cap) or "time" (the time cap); "" if settled
+    moved: int = 0  # places the settle moved (its island); every other place stayed where it was
 
 
 @dataclass(frozen=True)
@@ -100,6 +118,14 @@ class AbstractMap:
     exploration_factor: float = 1.0
     explored_centre: np.ndarray | None = None
     start_roots: list[str] = field(default_factory=list)
+    # bumped by every change to the clauses or fixed points; with the hierarchy's version it keys _memo
+    _version: int = field(default=0, init=False, repr=False, compare=False)
+    _memo: dict[str, tuple[tuple, object]] = field(default_factory=dict, init=False, repr=False, compare=False)
+    _clause_springs: dict[Clause, list[Spring]] = field(default_factory=dict, init=False, repr=False, compare=False)
+    _resolved_memo: dict[Spring, Resolved] = field(default_factory=dict, init=False, repr=False, compare=False)
+    # what the last settle saw, to tell the next what changed, and the springs by mass (derived, not saved)
+    _last_settle: _LastSettle | None = field(default=None, init=False, repr=False, compare=False)
+    _index: SpringIndex = field(default_factory=SpringIndex, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not isinstance(self.hierarchy, Hierarchy):
@@ -123,10 +149,26 @@ class AbstractMap:
         return cls(hierarchy=hierarchy, start=tuple(start), params=params or AbstractMapParams(),  # type: ignore[arg-type]
                    goal=goal)
 
+    def _cached(self, key: str, make: Callable[[], T], *extra: object) -> T:
+        """``make()``, remembered until the clauses, fixed points, hierarchy (or ``extra``) change."""
+        version = (self._version, self.hierarchy.version, id(self.cue_clauses), len(self.cue_clauses),
+                   id(self.loose_clauses), len(self.loose_clauses), *extra)
+        hit = self._memo.get(key)
+        if hit is None or hit[0] != version:
+            hit = self._memo[key] = (version, make())
+        return hit[1]  # type: ignore[return-value]
+
+    def _changed(self) -> None:
+        """Forget what was derived from the clauses and fixed points."""
+        self._version += 1
+
     def places(self) -> list[str]:
         """Every place a cue or the hierarchy mentions, in first-mention order."""
-        names: dict[str, None] = dict.fromkeys(self.hierarchy.places)
-        for clause in self.clauses():
+        return list(self._cached("places", self._places))
+
+    def _places(self) -> list[str]:
+        names: dict[str, None] = dict.fromkeys(self.hierarchy.places)  # the hierarchy's clauses name only these
+        for clause in [c for cs in self.cue_clauses.values() for c in cs] + self.loose_clauses:
             for name in _clause_names(clause):
                 if not is_anchor(name):
                     names.setdefault(name, None)
@@ -134,6 +176,9 @@ class AbstractMap:
 
     def clauses(self) -> list[Clause]:
         """All clauses: the hierarchy's, then each cue's, then loose ones."""
+        return list(self._cached("clauses", self._clauses))
+
+    def _clauses(self) -> list[Clause]:
         out: list[Clause] = list(self.hierarchy.clauses())
         for clauses in self.cue_clauses.values():
             out.extend(clauses)
@@ -142,10 +187,12 @@ class AbstractMap:
 
     def _name_index(self) -> dict[str, str]:
         """Case-folded place name -> the spelling first used."""
-        index: dict[str, str] = {}
-        for place in self.places():
-            index.setdefault(place.casefold(), place)
-        return index
+        def make() -> dict[str, str]:
+            index: dict[str, str] = {}
+            for place in self.places():
+                index.setdefault(place.casefold(), place)
+            return index
+        return self._cached("name_index", make)
 
     def canonical(self, name: str, index: Mapping[str, str] | None = None) -> str:
         """A known place's spelling for ``name`` (case-insensitive), else ``name`` itself."""
@@ -223,6 +270,7 @@ class AbstractMap:
         added, edges = self._prepare(list(clauses), self.fixed, skip=self.loose_clauses)
         self._commit_edges(edges)
         self.loose_clauses.extend(added)
+        self._changed()
         if added:
             self.exploration_factor = 1.0
         return added
@@ -271,6 +319,7 @@ class AbstractMap:
             for f in dataclasses.fields(point):
                 setattr(earlier, f.name, getattr(point, f.name))
         self.cue_clauses[name] = clauses
+        self._changed()
         return Observation(tag, earlier is None, tuple(clauses))
 
     # -- reading ------------------------------------------------------------------
@@ -280,8 +329,17 @@ class AbstractMap:
 
     def springs(self) -> list[Spring]:
         """Every spring of the model (the start's pull on the roots included)."""
+        return list(self._cached("springs", self._springs))
+
+    def _springs(self) -> list[Spring]:
         flags = {"between_angle": self.params.between_angle}
-        springs = springs_from_clauses(self.clauses(), self._anchor_kind, flags)
+        unique: dict[Spring, None] = {}
+        for clause in self.clauses():  # each clause's springs depend on it and its anchors' kinds, which never change
+            made = self._clause_springs.get(clause)
+            if made is None:
+                made = self._clause_springs[clause] = clause_springs(clause, self._anchor_kind, flags)
+            unique.update(dict.fromkeys(made))
+        springs = list(unique)
         k = STIFFNESS[self.params.start_stiffness]
         for root in self.start_roots:
             springs.append(Spring("distance", (root, START_ANCHOR), 1.0, k, "start"))
@@ -294,11 +352,16 @@ class AbstractMap:
 
     def levels(self) -> dict[str, int]:
         """Hierarchy level of every place (places outside the hierarchy are leaves, 1)."""
-        levels = self.hierarchy.levels()
-        return {p: levels.get(p, 1) for p in self.places()}
+        def make() -> dict[str, int]:
+            levels = self.hierarchy.levels()
+            return {p: levels.get(p, 1) for p in self.places()}
+        return dict(self._cached("levels", make))
 
     def observed_positions(self) -> dict[str, np.ndarray]:
         """Every fixed point's position, and each observed place's (the mean of its label tags)."""
+        return dict(self._cached("observed", self._observed_positions))
+
+    def _observed_positions(self) -> dict[str, np.ndarray]:
         labels: dict[str, list[np.ndarray]] = {}
         for clauses in self.cue_clauses.values():
             for c in clauses:
@@ -322,14 +385,21 @@ class AbstractMap:
 
     def resolved_springs(self) -> list[Resolved]:
         """Springs with natural lengths in metres and angles in radians."""
-        levels = self.levels()
+        return list(self._cached("resolved", self._resolved_springs, self.exploration_factor))
+
+    def _resolved_springs(self) -> list[Resolved]:
+        levels = self._cached("levels", self.levels)
         springs = self.springs()
-        learned = learn_scales(springs, levels, self.observed_positions().get)
+        learned = learn_scales(springs, levels, self._cached("observed", self._observed_positions).get)
+        lengths = natural_lengths(springs, levels, learned, self.params.scales, self.exploration_factor)
+        memo = self._resolved_memo  # the same spring at the same length: the same value, made once
         out = []
-        for s in springs:
-            value = (natural_length(s, levels, learned, self.params.scales, self.exploration_factor)
-                     if s.kind == "distance" else s.value)
-            out.append(Resolved(s.kind, s.ends, value, s.stiffness))
+        for s, length in zip(springs, lengths):
+            value = length if s.kind == "distance" else s.value
+            made = memo.get(s)
+            if made is None or made.value != value:
+                made = memo[s] = Resolved(s.kind, s.ends, value, s.stiffness)
+            out.append(made)
         return out
 
     def position(self, place: str) -> np.ndarray:
@@ -374,6 +444,60 @@ class AbstractMap:
             return
         self.explored_centre = np.array(errors.point("explored centre", xy, error=ModelError))
 
+    def _disturbed(self, springs: list[Resolved], new: list[str],
+                   fixed: Mapping[str, np.ndarray]) -> tuple[list[str], list[str]]:
+        """Bring the spring index up to date; the places a settle starts from, and those it tests first.
+
+        The first settle moves every place. After it: the new places and those a capped settle left moving
+        (|v| >= L_v) move; the ends of springs added, removed or changed, and of springs to fixed points that
+        moved, since the last settle are tested, and move if they fail Algorithm 1's acceleration test."""
+        current = set(springs)
+        last = self._last_settle
+        if last is None or len(springs) - len(current) or last.duplicates:  # a spring twice: count them all
+            self._index = SpringIndex(springs)
+            if last is None:
+                return [p for p in self.places() if p in self.positions], []
+            changed: Iterable[Resolved] = sorted((Counter(springs) - last.count) + (last.count - Counter(springs)),
+                                                 key=_spring_key)
+        else:
+            added, removed = current - last.springs, last.springs - current
+            self._index.update(added, removed)
+            self._index.rank_by(springs)
+            changed = sorted([*added, *removed], key=_spring_key)  # sets: put in an order no hash decides
+        tested: dict[str, None] = {}
+        for spring in changed:
+            tested.update(dict.fromkeys(spring.ends))
+        for name, xy in fixed.items():
+            if name not in last.fixed or not np.array_equal(last.fixed[name], xy):
+                for spring in self._index.around([name]):
+                    tested.update(dict.fromkeys(spring.ends))
+        return [*new, *last.moving], [p for p in tested if p in self.positions]
+
+    def as_last_settled(self) -> list[str] | None:
+        """If nothing has changed since the last settle, the places it left moving (|v| >= L_v); else None.
+
+        A saved model keeps this, so a loaded one settles exactly as the original would
+        (:meth:`resume_settled`); without it the first settle after loading moves every place."""
+        last = self._last_settle
+        if last is None:
+            return None
+        springs = self.resolved_springs()
+        fixed = {n: f.xy for n, f in self.fixed.items()}
+        same = (set(springs) == last.springs and len(springs) - len(last.springs) == last.duplicates
+                and fixed.keys() == last.fixed.keys()
+                and all(np.array_equal(xy, last.fixed[n]) for n, xy in fixed.items())
+                and set(self.places()) <= set(self.positions))
+        return list(last.moving) if same else None
+
+    def resume_settled(self, moving: Iterable[str]) -> None:
+        """Take the model as its last settle left it, with ``moving`` still moving (see :meth:`as_last_settled`)."""
+        springs = self.resolved_springs()
+        current = set(springs)
+        self._index = SpringIndex(springs)
+        self._last_settle = _LastSettle(current, Counter(springs) if len(current) < len(springs) else Counter(),
+                                        len(springs) - len(current), {n: f.xy for n, f in self.fixed.items()},
+                                        [p for p in moving if p in self.positions])
+
     def settle(self, *, max_steps: int | None = None, max_s: float | None = None) -> SettleReport:
         """Place new masses (Algorithm 2), then integrate until settled (Algorithm 1) or a cap is hit.
 
@@ -388,16 +512,19 @@ class AbstractMap:
         new = [p for p in places if p not in self.positions]
         known = {**{n: f.xy for n, f in self.fixed.items()}, **self.positions}
         origin = np.array(self.start[:2])
-        placed = place_new_masses(new, known, springs, origin=origin, heading=self.start[2],
+        new_set = set(new)
+        near = [s for s in springs if not new_set.isdisjoint(s.ends)] if new else []  # Algorithm 2 needs no other
+        placed = place_new_masses(new, known, near, origin=origin, heading=self.start[2],
                                   min_separation=self.params.dynamics.min_separation)
         for name, xy in placed.items():
             self.positions[name] = xy
             self.velocities[name] = np.zeros(2)
         parents = set(self.hierarchy.parent.values())
-        leaves = [p for p in places if p not in parents]
-        expand = leaves if self.params.dynamics.expansion_on == "leaves" else places
-        result = run_dynamics({p: self.positions[p] for p in places}, self.velocities,
-                              {n: f.xy for n, f in self.fixed.items()}, springs,
+        expand = set(places) if self.params.dynamics.expansion_on == "all" else \
+            {p for p in places if p not in parents}
+        fixed = {n: f.xy for n, f in self.fixed.items()}
+        active, tested = self._disturbed(springs, new, fixed)
+        result = run_dynamics(self.positions, self.velocities, fixed, self._index, active=active, tested=tested,
                               expand=expand, centre=self.explored_centre, params=self.params.dynamics,
                               max_steps=max_steps, deadline=None if max_s is None else began + max_s)
         bad = [n for n, xy in result.positions.items() if not np.all(np.abs(xy) <= errors.COORDINATE_LIMIT_M)]
@@ -409,8 +536,13 @@ class AbstractMap:
                              "the model is unchanged")
         self.positions.update(result.positions)
         self.velocities.update(result.velocities)
+        limit = self.params.dynamics.settle_velocity
+        current = set(springs)
+        self._last_settle = _LastSettle(current, Counter(springs) if len(current) < len(springs) else Counter(),
+                                        len(springs) - len(current), fixed,
+                                        [n for n, v in result.velocities.items() if float(np.hypot(*v)) >= limit])
         return SettleReport(result.settled, result.iterations, time.perf_counter() - began, tuple(new),
-                            result.stopped_by)
+                            result.stopped_by, len(result.positions))
 
 
 def settle_caps(max_steps: object, max_s: object, *, names: tuple[str, str] = ("settle max_steps", "settle max_s"),
@@ -430,32 +562,24 @@ EXPLORATION_LAWS = {
 
 def _loose_groups(places: list[str], springs: list[Spring]) -> list[str]:
     """The first place (in ``places`` order) of each group that no chain of springs ties to a fixed point."""
-    parent = {p: p for p in places}
-
-    def find(name: str) -> str:
-        root = name
-        while parent[root] != root:
-            root = parent[root]
-        while parent[name] != root:
-            parent[name], name = root, parent[name]
-        return root
-
-    anchored: set[str] = set()
-    for spring in springs:
-        ends = [e for e in spring.ends if e in parent]
-        if len(ends) < len(spring.ends):
-            anchored.update(ends)  # a fixed point holds this spring's places
-        for other in ends[1:]:
-            a, b = find(ends[0]), find(other)
-            if a != b:
-                parent[b] = a
-    held = {find(p) for p in anchored}
-    firsts: dict[str, str] = {}
-    for place in places:
-        root = find(place)
-        if root not in held:
-            firsts.setdefault(root, place)
+    if not places:
+        return []
+    slot = {p: i for i, p in enumerate(places)}
+    anchor = len(places)  # one node stands for every fixed point
+    pairs = [(slot.get(s.ends[0], anchor), slot.get(e, anchor)) for s in springs for e in s.ends[1:]]
+    rows, cols = np.array(pairs, dtype=int).reshape(-1, 2).T
+    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(anchor + 1, anchor + 1))
+    _, label = connected_components(graph, directed=False)
+    held = label[anchor]
+    firsts: dict[int, str] = {}
+    for place, group in zip(places, label[:anchor].tolist()):
+        if group != held:
+            firsts.setdefault(group, place)
     return list(firsts.values())
+
+
+def _spring_key(spring: Resolved) -> tuple:
+    return spring.kind, spring.ends, spring.value, spring.stiffness
 
 
 def _clause_names(clause: Clause) -> list[str]:

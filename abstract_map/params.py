@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from .forces import ANGLE_LAWS, EXPANSION_LAWS
+from .forces import EXPANSION_LAWS
 
 STIFFNESS: dict[str, float] = {"XL": 2.5, "L": 1.0, "M": 0.5, "S": 0.1, "XS": 0.01}
 """Named spring stiffnesses (N/m for distance springs, N/rad for angle springs)."""
@@ -71,13 +71,25 @@ class DynamicsParams:
     expansion_law: str = "constant"  # "constant" (authors' code) or "proportional" (paper's text)
     expansion_on: str = "leaves"  # "leaves" (authors' code) or "all" free masses
     min_separation: float = 0.2  # m between free masses (they bounce)
-    angle_core: float = 0.5  # m, angle spring forces fade to zero inside this distance of their pivot
-    # "constant": an angle spring pushes with K * error (N) at any distance (the authors' code); "potential": with
-    # K * error * l / r, the force of the energy K l error^2 / 2, l being the natural length of the distance spring
-    # between the same places (the same force as "constant" there). "constant" has curl, so masses can orbit
-    # for ever (docs/method-notes.md, "settles that never come to rest"); "potential" cannot
-    angle_law: str = "constant"
-    angle_length: float = 1.0  # m, l for an angle spring with no distance spring between its places
+    # m, the angle springs' force is held at its value this far from their pivot nearer in, where the direction is
+    # ill-defined (the authors' code faded it to zero inside the same 0.5 m)
+    angle_core: float = 0.5
+    # of an angle spring's l: the force is held at its value at this share of l nearer in, so no angle spring
+    # pushes harder than 1 / share times the paper's K * error (forces.py): a place that passes close to a
+    # pivot is not flung round it, which at dt = 0.1 s feeds energy into the system
+    angle_core_share: float = 0.25
+    # m, l of an angle spring with no distance spring between its places: its force K * error * l / r is the
+    # paper's K * error at r = l (forces.py)
+    angle_length: float = 1.0
+    # Chipmunk's solver iterations per step. Only collisions between masses need more than one (a spring with
+    # no damping acts in one impulse); 3 keeps colliding masses apart at half the step cost of pymunk's 10
+    solver_iterations: int = 3
+    # m/s^2, a mass held still joins a settle when the net force on it would accelerate it at this or more.
+    # Above 0.02 (the expansion force, 0.01 N a leaf, turned right round by a move of the explored centre) so
+    # the robot's moving alone wakes nothing; well below L_a (0.1), as a weakly held place (a hierarchy spring
+    # is 0.01 N/m) would otherwise be left metres from where a full settle puts it. On the Lion replay a full
+    # settle (0 here) and this one differ by 3.6 m at the 90th percentile of places (median 0.05 m), 0.1 by 5.2 m
+    wake_acceleration: float = 0.025
     dt: float = 0.1  # s, integration step (paper: Runge-Kutta with dt 0.1; here pymunk's integrator)
     settle_acceleration: float = 0.1  # m/s^2, L_a
     settle_velocity: float = 0.1  # m/s, L_v
@@ -86,14 +98,19 @@ class DynamicsParams:
     def __post_init__(self) -> None:
         _choice("DynamicsParams.expansion_law", self.expansion_law, tuple(EXPANSION_LAWS))
         _choice("DynamicsParams.expansion_on", self.expansion_on, ("leaves", "all"))
-        _choice("DynamicsParams.angle_law", self.angle_law, ANGLE_LAWS)
-        for name in ("mass", "settle_acceleration", "settle_velocity", "angle_length"):
+        for name in ("mass", "settle_acceleration", "settle_velocity", "angle_length", "wake_acceleration",
+                     "angle_core"):
             _positive(f"DynamicsParams.{name}", getattr(self, name))
         _positive("DynamicsParams.dt", self.dt, high=10.0)
         if isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int):
             raise ValueError(f"DynamicsParams.max_iterations must be an integer, got {self.max_iterations!r}")
         _positive("DynamicsParams.max_iterations", self.max_iterations, high=1e6)
-        for name in ("friction", "expansion", "min_separation", "angle_core"):
+        if isinstance(self.solver_iterations, bool) or not isinstance(self.solver_iterations, int) \
+                or not 1 <= self.solver_iterations <= 100:
+            raise ValueError(f"DynamicsParams.solver_iterations must be an integer in [1, 100], "
+                             f"got {self.solver_iterations!r}")
+        _positive("DynamicsParams.angle_core_share", self.angle_core_share, allow_zero=True, high=1.0)
+        for name in ("friction", "expansion", "min_separation"):
             _positive(f"DynamicsParams.{name}", getattr(self, name), allow_zero=True)
 
 

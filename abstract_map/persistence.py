@@ -10,6 +10,7 @@ the loaded model settles exactly as the saved one would.
 from __future__ import annotations
 
 import json
+import logging
 import os
 from dataclasses import asdict, fields
 from pathlib import Path
@@ -27,10 +28,17 @@ from .params import AbstractMapParams, DynamicsParams, ExplorationParams, ScaleD
 
 __all__ = ["FORMAT", "ModelFileError", "from_dict", "load", "save", "to_dict"]
 
+log = logging.getLogger(__name__)
+
 FORMAT = "abstract-map/1"
 _KEYS = ("format", "params", "hierarchy", "start", "start_roots", "goal", "fixed", "cue_clauses",
-         "loose_clauses", "positions", "velocities", "exploration_factor", "explored_centre")
+         "loose_clauses", "positions", "velocities", "exploration_factor", "explored_centre", "settled_moving")
+# "settled_moving": null, or the places left moving when the model is saved just as its last settle left it
 _FIXED_KEYS = ("kind", "x", "y", "theta", "sightings", "text")
+# dynamics parameters older files lack (they load with the defaults)
+_NEW_DYNAMICS = ("angle_length", "angle_core_share", "wake_acceleration", "solver_iterations")
+# dynamics parameters older files have that no longer exist, and what replaced them
+_RETIRED_DYNAMICS = {"angle_law": "angle springs follow the potential law, the force of K l error^2 / 2"}
 
 
 def params_to_dict(params: AbstractMapParams) -> dict[str, Any]:
@@ -84,8 +92,13 @@ def params_from_dict(data: Any, *, where: str = "params") -> AbstractMapParams:
             raise ModelFileError(f"{where} scales place: expected a level pair such as '1-2', got {key!r}")
         place[(_level(f"{where} scales place", parts[0]), _level(f"{where} scales place", parts[1]))] = \
             errors.number(f"{where} scales place[{key}]", value, error=ModelFileError)
-    dynamics = _object(f"{where} dynamics", data["dynamics"], tuple(f.name for f in fields(DynamicsParams)),
-                       optional=("angle_law", "angle_length"))  # files from before the potential law
+    dynamics = dict(_object(f"{where} dynamics", data["dynamics"],
+                            (*(f.name for f in fields(DynamicsParams)), *_RETIRED_DYNAMICS),
+                            optional=(*_NEW_DYNAMICS, *_RETIRED_DYNAMICS)))
+    for key, meaning in _RETIRED_DYNAMICS.items():
+        if key in dynamics:
+            log.warning("%s dynamics: %s=%s is no longer a parameter (%s)", where, key,
+                        errors.show(dynamics.pop(key)), meaning)
     exploration = _object(f"{where} exploration", data["exploration"],
                           tuple(f.name for f in fields(ExplorationParams)), optional=("max_factor",))
     try:
@@ -118,6 +131,7 @@ def to_dict(model: AbstractMap) -> dict[str, Any]:
         "velocities": {n: [float(v) for v in xy] for n, xy in model.velocities.items()},
         "exploration_factor": model.exploration_factor,
         "explored_centre": None if model.explored_centre is None else [float(v) for v in model.explored_centre],
+        "settled_moving": model.as_last_settled(),
     }
 
 
@@ -174,7 +188,7 @@ def from_dict(data: Any, *, where: str = "model") -> AbstractMap:
     data = _object(where, data)
     if data.get("format") != FORMAT:
         raise ModelFileError(f"{where}: format {errors.show(data.get('format'))}, expected {FORMAT!r}")
-    data = _object(where, data, _KEYS)
+    data = _object(where, data, _KEYS, optional=("settled_moving",))  # files from before island settles lack it
     params = params_from_dict(data["params"], where=f"{where} params")
     spec = _object(f"{where} hierarchy", data["hierarchy"], ("places", "parent"))
     try:
@@ -237,6 +251,15 @@ def from_dict(data: Any, *, where: str = "model") -> AbstractMap:
                 raise ModelFileError(f"{where} goal: {errors.show(goal)} is not a place's spelling")
         model.springs()
         model.levels()
+        moving = data.get("settled_moving")
+        if moving is not None:
+            moving = [_name(f"{where} settled_moving", n) for n in _list(f"{where} settled_moving", moving)]
+            unknown = [n for n in moving if n not in model.positions]
+            if unknown:
+                raise ModelFileError(f"{where} settled_moving: {errors.show(unknown[0])} is not a placed place")
+            if not set(model.places()) <= set(model.positions):
+                raise ModelFileError(f"{where} settled_moving: given, but some places have no position")
+            model.resume_settled(moving)
     except ModelFileError:
         raise
     except (AbstractMapError, ValueError) as exc:

@@ -16,11 +16,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .values import RememberedHash
+
 GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 
 
 @dataclass(frozen=True)
-class Resolved:
+class Resolved(RememberedHash):
     """A spring with its natural value in SI units: metres (distance) or radians (angles)."""
 
     kind: str

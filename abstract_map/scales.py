@@ -67,6 +67,22 @@ def learn_scales(springs: Sequence[Spring], levels: Mapping[str, int],
     return {key: total / weight for key, (total, weight) in sums.items() if weight > 0 and total > 0}
 
 
+def natural_lengths(springs: Sequence[Spring], levels: Mapping[str, int], learned: Mapping[ScaleKey, float],
+                    defaults: ScaleDefaults, exploration: float) -> list[float]:
+    """:func:`natural_length` of every distance spring (0 for angle springs), each scale looked up once."""
+    alpha: dict[ScaleKey, float] = {}
+    out = []
+    for spring in springs:
+        if spring.kind != "distance":
+            out.append(0.0)
+            continue
+        key = scale_key(spring, levels)
+        if key not in alpha:
+            alpha[key] = learned.get(key, default_scale(key, defaults))
+        out.append(spring.value * alpha[key] * (1.0 if spring.scale == "label" else exploration))
+    return out
+
+
 def natural_length(spring: Spring, levels: Mapping[str, int], learned: Mapping[ScaleKey, float],
                    defaults: ScaleDefaults, exploration: float) -> float:
     """Natural length (m) of a distance spring: units x scale x exploration (labels are not explored)."""

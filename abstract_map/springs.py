@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from .clauses import Clause, Locational, Relational, is_anchor
 from .params import STIFFNESS
 from .prepositions import LOCATIONAL, TABLE, Rule
+from .values import RememberedHash
 
 log = logging.getLogger(__name__)
 
@@ -25,7 +26,7 @@ SCALE_KINDS = ("place", "sign", "label", "start")
 
 
 @dataclass(frozen=True)
-class Spring:
+class Spring(RememberedHash):
     """A spring between masses.
 
     distance: ``ends = (a, b)``, ``value`` in unit lengths, ``scale`` picks the scale table.

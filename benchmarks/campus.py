@@ -128,11 +128,11 @@ def walk(campus: Campus, *, max_cues: int | None = None, max_seconds: float | No
     model = AbstractMap.from_hierarchy(Hierarchy.from_nested(campus.tree), campus.start)
     visited = np.array(campus.start[:2])
     model.set_explored_centre(visited)
-    caps_kw = {} if max_seconds is None else {"max_seconds": max_seconds}  # older checkouts have no caps
+    caps_kw = {} if max_seconds is None else {"max_s": max_seconds}  # older checkouts have no per-call caps
     cpu0, wall0 = time.process_time(), time.perf_counter()
     model.settle(**caps_kw)
     first = (time.process_time() - cpu0, time.perf_counter() - wall0)
-    cpu, wall, steps, converged, caps = [], [], [], 0, {"steps": 0, "time": 0}
+    cpu, wall, steps, moved, converged, caps = [], [], [], [], 0, {"steps": 0, "time": 0}
     named_at: dict[str, np.ndarray] = {}  # place -> the sign that first named it
     seen: set[str] = set()
     errors, guesses = [], []
@@ -146,8 +146,9 @@ def walk(campus: Campus, *, max_cues: int | None = None, max_seconds: float | No
         cpu.append(time.process_time() - cpu0)
         wall.append(time.perf_counter() - wall0)
         steps.append(report.iterations)
+        moved.append(getattr(report, "moved", len(model.positions)))  # older checkouts move every place
         converged += report.settled
-        cap = getattr(report, "cap", "" if report.settled else "steps")
+        cap = getattr(report, "stopped_by", "" if report.settled else "steps")
         if cap:
             caps[cap] += 1
         for clause in observation.clauses:
@@ -170,7 +171,8 @@ def walk(campus: Campus, *, max_cues: int | None = None, max_seconds: float | No
         "of_cues": len(campus.cues), "first_settle_cpu_s": first[0], "first_settle_wall_s": first[1],
         "median_cpu_ms": 1000 * statistics.median(cpu), "p95_cpu_ms": 1000 * float(np.percentile(cpu, 95)),
         "median_wall_ms": 1000 * statistics.median(wall), "p95_wall_ms": 1000 * float(np.percentile(wall, 95)),
-        "median_steps": statistics.median(steps), "converged": converged, "caps": caps,
+        "median_steps": statistics.median(steps), "median_moved": statistics.median(moved),
+        "converged": converged, "caps": caps,
         "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
         "error_median_m": statistics.median(errors) if errors else math.nan,
         "guess_median_m": statistics.median(guesses) if guesses else math.nan,

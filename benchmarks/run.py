@@ -12,9 +12,9 @@ settle   median CPU time per settle on the Lion replay (the authors' code: 1.5-5
          settle converged and how far the imagined Lion ends from its tag. --against REF also runs it on the
          git ref REF (a temporary git worktree on PYTHONPATH) and prints the ratio of medians.
 campus   a robot walking a generated campus (benchmarks/campus.py), one cue at a time with a settle after
-         each: 500 places (the whole walk) and 5,000 (its first 30 cues; --cues N to change). Median and p95
-         settle, converged settles, peak memory, imagined-position error of places named but not yet seen.
-campus20k  the same at 20,000 places (its first 20 cues); named only
+         each: 500 and 5,000 places, each the whole walk (--cues N for the first N). Median and p95 settle,
+         places moved, converged settles, peak memory, imagined-position error of places named but not yet seen.
+campus20k  the same at 20,000 places (the whole walk, about an hour; --cues N for fewer); named only
 trials   wall time and real-time factor of the Lion trial, per perception mode
 study    total wall time of a small study (1 trial per goal, geometric, 2 workers)
 generate time to generate a building per style and size, and how many pass the world check
@@ -124,7 +124,7 @@ def bench_settle(against: str | None = None, runs: int = 3) -> None:
         print(f"median settle ratio {against} / this checkout: {results[against]['median'] / median:.2f}")
 
 
-CAMPUS_CUES = {500: None, 5000: 30, 20000: 20}  # cues walked per size (None: the whole walk)
+CAMPUS_CUES = {500: None, 5000: None, 20000: None}  # cues walked per size (None: the whole walk); --cues N
 
 
 def campus_walk(checkout_dir: Path, n: int, cues: int | None) -> dict:
@@ -147,12 +147,13 @@ def bench_campus(sizes: tuple[int, ...] = (500, 5000), cues: int | None = None, 
                 rows.append([name, str(f["places"]), f"{f['cues']}/{f['of_cues']}",
                              f"{f['first_settle_cpu_s']:.1f}", f"{f['median_cpu_ms']:.0f}",
                              f"{f['p95_cpu_ms']:.0f}", str(int(f["median_steps"])),
+                             str(int(f.get("median_moved", f["places"]))),
                              f"{f['converged']}/{f['cues']}" + (f" ({caps['time']} at the time cap)"
                                                                 if caps.get("time") else ""),
                              f"{f['peak_mb']:.0f}", f"{f['error_median_m']:.1f} / {f['guess_median_m']:.1f}"])
     table("Campus walk: one cue at a time, a settle after each (CPU time)", [
         "code", "places", "cues walked", "hierarchy settle (s)", "median ms/settle", "p95 ms", "median steps",
-        "converged", "peak MB", "named, unseen: median error / guess at sign (m)"], rows)
+        "median places moved", "converged", "peak MB", "named, unseen: median error / guess at sign (m)"], rows)
 
 
 def bench_trials(goal: str = "Lion") -> None:
