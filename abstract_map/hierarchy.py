@@ -9,7 +9,7 @@ as ``{"Campus": {"A Block": {"Room 1": {}}}}``.
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+from collections.abc import Callable, Hashable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -19,6 +19,7 @@ from defusedxml.common import DefusedXmlException
 
 from .clauses import Relational
 from .errors import HierarchyError, place_name
+from .values import T, remembered
 
 __all__ = ["Hierarchy", "HierarchyError"]
 
@@ -34,7 +35,7 @@ class Hierarchy:
     places: list[str] = field(default_factory=list)  # every place, in document order
 
     def __post_init__(self) -> None:
-        self._cache: dict[str, tuple[tuple[int, int], Any]] = {}  # derived data by the version it was made at
+        self._cache: dict[str, tuple[Hashable, Any]] = {}  # derived data by the version it was made at
         self._known = set(self.places)
         self._with_children = set(self.parent.values())
         if len(self._known) != len(self.places):
@@ -91,12 +92,8 @@ class Hierarchy:
         """Changes whenever the hierarchy does (it only grows: edges and places are never removed)."""
         return len(self.parent), len(self.places)
 
-    def _cached(self, key: str, make: Any) -> Any:
-        version = self.version
-        hit = self._cache.get(key)
-        if hit is None or hit[0] != version:
-            hit = self._cache[key] = (version, make())
-        return hit[1]
+    def _cached(self, key: str, make: Callable[[], T]) -> T:
+        return remembered(self._cache, key, self.version, make)
 
     def levels(self) -> dict[str, int]:
         """Level of every place: leaves 1, a parent one above its highest child (a shared table: do not change)."""

@@ -13,9 +13,9 @@ import dataclasses
 import math
 import time
 from collections import Counter
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Hashable, Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import TypeVar
+from typing import Any
 
 import numpy as np
 from scipy.sparse import coo_matrix
@@ -32,12 +32,12 @@ from .params import STIFFNESS, AbstractMapParams
 from .placement import Resolved, place_new_masses
 from .prepositions import LOCATIONAL, TABLE
 from .scales import ScaleKey, learn_scales, natural_lengths
-from .springs import Spring, clause_springs
+from .springs import Spring, clause_springs, springs_from_clauses
+from .values import T, remembered
 
 __all__ = ["AbstractMap", "FixedPoint", "Observation", "SettleReport", "UnknownPlaceError", "imagined_positions"]
 
 FIXED_KINDS = ("label", "sign", "start")
-T = TypeVar("T")
 
 
 @dataclass
@@ -74,6 +74,12 @@ class _LastSettle:
     duplicates: int  # occurrences beyond the first, all springs together
     fixed: dict[str, np.ndarray]  # m, every fixed point
     moving: list[str]  # places left with |v| >= L_v (by a cap)
+
+    @classmethod
+    def of(cls, springs: list[Resolved], fixed: dict[str, np.ndarray], moving: list[str]) -> _LastSettle:
+        current = set(springs)
+        duplicates = len(springs) - len(current)
+        return cls(current, Counter(springs) if duplicates else Counter(), duplicates, fixed, moving)
 
 
 @dataclass(frozen=True)
@@ -120,7 +126,7 @@ class AbstractMap:
     start_roots: list[str] = field(default_factory=list)
     # bumped by every change to the clauses or fixed points; with the hierarchy's version it keys _memo
     _version: int = field(default=0, init=False, repr=False, compare=False)
-    _memo: dict[str, tuple[tuple, object]] = field(default_factory=dict, init=False, repr=False, compare=False)
+    _memo: dict[str, tuple[Hashable, Any]] = field(default_factory=dict, init=False, repr=False, compare=False)
     _clause_springs: dict[Clause, list[Spring]] = field(default_factory=dict, init=False, repr=False, compare=False)
     _resolved_memo: dict[Spring, Resolved] = field(default_factory=dict, init=False, repr=False, compare=False)
     # what the last settle saw, to tell the next what changed, and the springs by mass (derived, not saved)
@@ -153,10 +159,7 @@ class AbstractMap:
         """``make()``, remembered until the clauses, fixed points, hierarchy (or ``extra``) change."""
         version = (self._version, self.hierarchy.version, id(self.cue_clauses), len(self.cue_clauses),
                    id(self.loose_clauses), len(self.loose_clauses), *extra)
-        hit = self._memo.get(key)
-        if hit is None or hit[0] != version:
-            hit = self._memo[key] = (version, make())
-        return hit[1]  # type: ignore[return-value]
+        return remembered(self._memo, key, version, make)
 
     def _changed(self) -> None:
         """Forget what was derived from the clauses and fixed points."""
@@ -332,14 +335,9 @@ class AbstractMap:
         return list(self._cached("springs", self._springs))
 
     def _springs(self) -> list[Spring]:
-        flags = {"between_angle": self.params.between_angle}
-        unique: dict[Spring, None] = {}
-        for clause in self.clauses():  # each clause's springs depend on it and its anchors' kinds, which never change
-            made = self._clause_springs.get(clause)
-            if made is None:
-                made = self._clause_springs[clause] = clause_springs(clause, self._anchor_kind, flags)
-            unique.update(dict.fromkeys(made))
-        springs = list(unique)
+        # each clause's springs depend on it and its anchors' kinds, which never change: made once
+        springs = springs_from_clauses(self.clauses(), self._anchor_kind, {"between_angle": self.params.between_angle},
+                                       memo=self._clause_springs)
         k = STIFFNESS[self.params.start_stiffness]
         for root in self.start_roots:
             springs.append(Spring("distance", (root, START_ANCHOR), 1.0, k, "start"))
@@ -352,10 +350,11 @@ class AbstractMap:
 
     def levels(self) -> dict[str, int]:
         """Hierarchy level of every place (places outside the hierarchy are leaves, 1)."""
-        def make() -> dict[str, int]:
-            levels = self.hierarchy.levels()
-            return {p: levels.get(p, 1) for p in self.places()}
-        return dict(self._cached("levels", make))
+        return dict(self._cached("levels", self._levels))
+
+    def _levels(self) -> dict[str, int]:
+        levels = self.hierarchy.levels()
+        return {p: levels.get(p, 1) for p in self.places()}
 
     def observed_positions(self) -> dict[str, np.ndarray]:
         """Every fixed point's position, and each observed place's (the mean of its label tags)."""
@@ -388,7 +387,7 @@ class AbstractMap:
         return list(self._cached("resolved", self._resolved_springs, self.exploration_factor))
 
     def _resolved_springs(self) -> list[Resolved]:
-        levels = self._cached("levels", self.levels)
+        levels = self._cached("levels", self._levels)
         springs = self.springs()
         learned = learn_scales(springs, levels, self._cached("observed", self._observed_positions).get)
         lengths = natural_lengths(springs, levels, learned, self.params.scales, self.exploration_factor)
@@ -492,11 +491,9 @@ class AbstractMap:
     def resume_settled(self, moving: Iterable[str]) -> None:
         """Take the model as its last settle left it, with ``moving`` still moving (see :meth:`as_last_settled`)."""
         springs = self.resolved_springs()
-        current = set(springs)
         self._index = SpringIndex(springs)
-        self._last_settle = _LastSettle(current, Counter(springs) if len(current) < len(springs) else Counter(),
-                                        len(springs) - len(current), {n: f.xy for n, f in self.fixed.items()},
-                                        [p for p in moving if p in self.positions])
+        self._last_settle = _LastSettle.of(springs, {n: f.xy for n, f in self.fixed.items()},
+                                           [p for p in moving if p in self.positions])
 
     def settle(self, *, max_steps: int | None = None, max_s: float | None = None) -> SettleReport:
         """Place new masses (Algorithm 2), then integrate until settled (Algorithm 1) or a cap is hit.
@@ -537,10 +534,8 @@ class AbstractMap:
         self.positions.update(result.positions)
         self.velocities.update(result.velocities)
         limit = self.params.dynamics.settle_velocity
-        current = set(springs)
-        self._last_settle = _LastSettle(current, Counter(springs) if len(current) < len(springs) else Counter(),
-                                        len(springs) - len(current), fixed,
-                                        [n for n, v in result.velocities.items() if float(np.hypot(*v)) >= limit])
+        self._last_settle = _LastSettle.of(springs, fixed, [n for n, v in result.velocities.items()
+                                                            if float(np.hypot(*v)) >= limit])
         return SettleReport(result.settled, result.iterations, time.perf_counter() - began, tuple(new),
                             result.stopped_by, len(result.positions))
 

@@ -69,7 +69,8 @@ def learn_scales(springs: Sequence[Spring], levels: Mapping[str, int],
 
 def natural_lengths(springs: Sequence[Spring], levels: Mapping[str, int], learned: Mapping[ScaleKey, float],
                     defaults: ScaleDefaults, exploration: float) -> list[float]:
-    """:func:`natural_length` of every distance spring (0 for angle springs), each scale looked up once."""
+    """Natural length (m) of every distance spring, units x scale x exploration (labels are not explored);
+    0 for angle springs. Each scale factor is looked up once."""
     alpha: dict[ScaleKey, float] = {}
     out = []
     for spring in springs:
@@ -81,12 +82,3 @@ def natural_lengths(springs: Sequence[Spring], levels: Mapping[str, int], learne
             alpha[key] = learned.get(key, default_scale(key, defaults))
         out.append(spring.value * alpha[key] * (1.0 if spring.scale == "label" else exploration))
     return out
-
-
-def natural_length(spring: Spring, levels: Mapping[str, int], learned: Mapping[ScaleKey, float],
-                   defaults: ScaleDefaults, exploration: float) -> float:
-    """Natural length (m) of a distance spring: units x scale x exploration (labels are not explored)."""
-    key = scale_key(spring, levels)
-    alpha = learned.get(key, default_scale(key, defaults))
-    factor = 1.0 if spring.scale == "label" else exploration
-    return spring.value * alpha * factor

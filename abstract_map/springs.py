@@ -122,11 +122,16 @@ def clause_springs(clause: Clause, anchor_kind: AnchorKind, flags: dict[str, boo
     return _locational_springs(clause, anchor_kind)
 
 
-def springs_from_clauses(clauses: Iterable[Clause], anchor_kind: AnchorKind,
-                         flags: dict[str, bool] | None = None) -> list[Spring]:
-    """All springs of the clauses, each spring once, in first-seen order."""
+def springs_from_clauses(clauses: Iterable[Clause], anchor_kind: AnchorKind, flags: dict[str, bool] | None = None,
+                         *, memo: dict[Clause, list[Spring]] | None = None) -> list[Spring]:
+    """All springs of the clauses, each spring once, in first-seen order. ``memo``, if given, keeps each
+    clause's springs from one call to the next (valid while ``anchor_kind`` and ``flags`` stay the same)."""
     unique: dict[Spring, None] = {}
     for clause in clauses:
-        for spring in clause_springs(clause, anchor_kind, flags):
-            unique.setdefault(spring, None)
+        made = None if memo is None else memo.get(clause)
+        if made is None:
+            made = clause_springs(clause, anchor_kind, flags)
+            if memo is not None:
+                memo[clause] = made
+        unique.update(dict.fromkeys(made))
     return list(unique)

@@ -1,8 +1,20 @@
-"""Frozen dataclasses whose hash is computed once: springs are gathered into sets and dicts on every settle."""
+"""Computing once what is asked for often: derived data until its inputs change, and frozen values' hashes."""
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable, Hashable
+from typing import Any, TypeVar
+
+T = TypeVar("T")
+
+
+def remembered(cache: dict[str, tuple[Hashable, Any]], key: str, version: Hashable, make: Callable[[], T]) -> T:
+    """``make()``, kept in ``cache`` under ``key`` and made again only when ``version`` differs from the one it
+    was made at. The value is shared: callers must not change it."""
+    hit = cache.get(key)
+    if hit is None or hit[0] != version:
+        hit = cache[key] = (version, make())
+    return hit[1]  # type: ignore[no-any-return]
 
 
 class RememberedHash:
