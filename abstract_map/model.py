@@ -529,6 +529,7 @@ class AbstractMap:
             for name in placed:
                 self.positions.pop(name, None)
                 self.velocities.pop(name, None)
+            self._last_settle = None  # the spring index already took this settle's changes: start afresh
             raise ModelError(f"settle diverged: {bad[0]!r} left the +-{errors.COORDINATE_LIMIT_M:g} m range; "
                              "the model is unchanged")
         self.positions.update(result.positions)

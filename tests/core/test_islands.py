@@ -132,3 +132,27 @@ def test_angle_springs_settle_where_the_potential_law_puts_them():
     x, y = result.positions["A"]
     assert math.degrees(math.atan2(y, x)) == pytest.approx(90.0, abs=3.0) and math.hypot(x, y) == pytest.approx(4.0,
                                                                                                                abs=0.3)
+
+
+def test_a_refused_settle_leaves_the_next_one_to_count_each_spring_once(monkeypatch):
+    import dataclasses
+    from collections import Counter
+
+    from abstract_map import model as model_module
+    from abstract_map.errors import ModelError
+
+    model, walk = walked(3)
+    model.observe_tag(*walk.cues[3])
+    real = model_module.run_dynamics
+
+    def diverging(*args, **kwargs):
+        result = real(*args, **kwargs)
+        name = next(iter(result.positions))
+        return dataclasses.replace(result, positions={**result.positions, name: np.array([1e7, 0.0])})
+
+    monkeypatch.setattr(model_module, "run_dynamics", diverging)
+    with pytest.raises(ModelError, match="diverged"):
+        model.settle()
+    monkeypatch.setattr(model_module, "run_dynamics", real)
+    assert model.settle().settled
+    assert model._index.count == Counter(model.resolved_springs())
