@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from .forces import forces_on
+from .forces import NetForce
 from .island import Island
 from .params import DynamicsParams
 from .placement import Resolved
@@ -147,6 +147,7 @@ def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndar
         z, velocity = island.read()
         if not np.allclose(z, [where[n] for n in island.names]):
             raise RuntimeError("pymunk returned bodies in an unexpected order")
+        woken = _EdgeTest(island, index, where, params)
         while True:
             if steps >= step_cap:
                 stopped_by = "steps"
@@ -162,10 +163,10 @@ def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndar
                            and np.abs(after - velocity).max() < dv_limit)
             velocity = after
             if at_rest or steps % _EDGE_EVERY == 0:
-                where.update(zip(island.names, z))
-                speed.update(zip(island.names, velocity))
-                joining = _woken(island.names, index, where, island.expand, centre, params, positions)
+                joining = woken(z)
                 if joining or at_rest:
+                    where.update(zip(island.names, z))
+                    speed.update(zip(island.names, velocity))
                     break
         if stopped_by:
             break
@@ -189,12 +190,39 @@ class _Zero:
         return 0.0, 0.0
 
 
-def _woken(names: Sequence[str], index: SpringIndex, where: Mapping[str, complex], expanding: Collection[str],
-           centre: np.ndarray | None, params: DynamicsParams, free: Mapping[str, np.ndarray]) -> list[str]:
-    """The free masses held still at the island's edge that fail the acceleration test, in a fixed order."""
-    inside = dict.fromkeys(names)
-    edge = list(dict.fromkeys(e for s in index.around(names) for e in s.ends if e in free and e not in inside))
-    return _failing(edge, index, where, expanding, centre, params)
+class _EdgeTest:
+    """The wake test of the masses an island holds still at its edge, made once for each shape of the island
+    (:meth:`Island.join` changes it): called with the island's positions, it returns those that fail."""
+
+    def __init__(self, island: Island, index: SpringIndex, where: Mapping[str, complex],
+                 params: DynamicsParams) -> None:
+        self.edge = list(island.edge)
+        self.net = _net_force(self.edge, index, island.expand, island.centre, params)
+        inside = {name: i for i, name in enumerate(island.names)}
+        mine = [(k, inside[n]) for k, n in enumerate(self.net.slots) if n in inside]
+        self.slot, self.of_island = (np.array(x, dtype=int) for x in zip(*mine)) if mine else \
+            (np.zeros(0, dtype=int), np.zeros(0, dtype=int))
+        self.z = np.array([where[n] for n in self.net.slots], dtype=complex)  # the rest hold still
+        self.limit = params.wake_acceleration * params.mass
+
+    def __call__(self, z: np.ndarray) -> list[str]:
+        if not self.edge:
+            return []
+        self.z[self.slot] = z[self.of_island]
+        force = np.abs(self.net(self.z))
+        return [self.edge[i] for i in np.flatnonzero(force >= self.limit)]
+
+
+def _net_force(names: Sequence[str], index: SpringIndex, expanding: Collection[str], centre: np.ndarray | None,
+               params: DynamicsParams) -> NetForce:
+    """The net force on ``names`` from every spring touching them (each as often as it occurs) and expansion."""
+    around = [s for s in index.around(names) for _ in range(index.count[s])]
+    return NetForce(names, around, [index.length(s, params.angle_length) if s.kind != "distance" else 0.0
+                                    for s in around],
+                    expand=[e in expanding for e in names],
+                    centre=None if centre is None else complex(float(centre[0]), float(centre[1])),
+                    expansion=params.expansion, law=params.expansion_law, core=params.angle_core,
+                    share=params.angle_core_share)
 
 
 def _failing(names: Sequence[str], index: SpringIndex, where: Mapping[str, complex], expanding: Collection[str],
@@ -203,12 +231,7 @@ def _failing(names: Sequence[str], index: SpringIndex, where: Mapping[str, compl
     ``params.wake_acceleration`` or more, in ``names`` order."""
     if not names:
         return []
-    around = [s for s in index.around(names) for _ in range(index.count[s])]
-    force = forces_on(names, around, where, [index.length(s, params.angle_length) if s.kind != "distance" else 0.0
-                                             for s in around],
-                      expand=[e in expanding for e in names],
-                      centre=None if centre is None else complex(float(centre[0]), float(centre[1])),
-                      expansion=params.expansion, law=params.expansion_law, core=params.angle_core,
-                      share=params.angle_core_share)
+    net = _net_force(names, index, expanding, centre, params)
+    force = net(np.array(list(map(where.__getitem__, net.slots)), dtype=complex))
     limit = params.wake_acceleration * params.mass
     return [e for e, f in zip(names, force) if abs(f) >= limit]

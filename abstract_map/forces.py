@@ -87,33 +87,57 @@ class AngleSprings:
         return np.bincount(self.ends, both.real, self.n) + 1j * np.bincount(self.ends, both.imag, self.n)
 
 
+class NetForce:
+    """The net force on a fixed list of masses from a fixed set of springs, evaluated as positions change.
+
+    ``slots`` lists every mass it reads: ``names`` first, then every other end of ``springs``, in order of
+    first appearance. ``lengths``: per spring, ``l`` (m) for an angle spring (ignored for distance springs);
+    ``expand``: per name, whether the expansion force pushes it."""
+
+    def __init__(self, names: Sequence[str], springs: Sequence[Resolved], lengths: Sequence[float], *,
+                 expand: Sequence[bool], centre: complex | None, expansion: float, law: str, core: float,
+                 share: float) -> None:
+        slot = {name: i for i, name in enumerate(names)}
+        for s in springs:
+            for end in s.ends:
+                slot.setdefault(end, len(slot))
+        self.slots = list(slot)
+        self.n = len(names)
+        self.angles = AngleSprings(len(slot), springs, [[slot[e] for e in s.ends] if s.kind != "distance" else []
+                                                        for s in springs], lengths, core=core, share=share)
+        distance = [s for s in springs if s.kind == "distance"]
+        self.a = np.array([slot[s.ends[0]] for s in distance], dtype=int)
+        self.b = np.array([slot[s.ends[1]] for s in distance], dtype=int)
+        self.stiffness = np.array([s.stiffness for s in distance], dtype=float)
+        self.rest = np.array([s.value for s in distance], dtype=float)
+        self.expand = np.asarray(expand, dtype=bool).reshape(-1)
+        self.push = None if centre is None or expansion == 0.0 or not self.expand.any() else \
+            (centre, EXPANSION_LAWS[law], expansion)
+
+    def __call__(self, z: np.ndarray) -> np.ndarray:
+        """Net force (N, complex) on each name, with every slot at complex position ``z`` (m)."""
+        total = self.angles(z)
+        if len(self.a):
+            d = z[self.b] - z[self.a]
+            r = np.abs(d)
+            f = self.stiffness * (r - self.rest) * d / np.maximum(r, 1e-12)  # pulls the first end to the second
+            total += np.bincount(self.a, f.real, len(z)) + 1j * np.bincount(self.a, f.imag, len(z))
+            total -= np.bincount(self.b, f.real, len(z)) + 1j * np.bincount(self.b, f.imag, len(z))
+        total = total[:self.n]
+        if self.push is not None:
+            centre, law, c = self.push
+            mine = z[:self.n] - centre
+            r = np.abs(mine)
+            ok = self.expand & (r > 1e-12)
+            total[ok] += law(c, r[ok]) * mine[ok] / r[ok]
+        return total
+
+
 def forces_on(names: Sequence[str], springs: Sequence[Resolved], where: Mapping[str, complex],
               lengths: Sequence[float], *, expand: Sequence[bool], centre: complex | None, expansion: float,
               law: str, core: float, share: float) -> np.ndarray:
     """Net force (N, complex) on each of ``names`` from ``springs`` (with every end's position in ``where``)
-    and, for those with ``expand`` true, the expansion force. ``lengths``: per spring, ``l`` (m) for an
-    angle spring (ignored for distance springs)."""
-    slot = {name: i for i, name in enumerate(names)}
-    for s in springs:
-        for end in s.ends:
-            slot.setdefault(end, len(slot))
-    z = np.array(list(map(where.__getitem__, slot)), dtype=complex)
-    total = AngleSprings(len(slot), springs, [[slot[e] for e in s.ends] if s.kind != "distance" else []
-                                              for s in springs], lengths, core=core, share=share)(z)
-    distance = [s for s in springs if s.kind == "distance"]
-    if distance:
-        a = np.array([slot[s.ends[0]] for s in distance])
-        b = np.array([slot[s.ends[1]] for s in distance])
-        d = z[b] - z[a]
-        r = np.abs(d)
-        f = np.array([s.stiffness for s in distance]) * (r - np.array([s.value for s in distance])) \
-            * d / np.maximum(r, 1e-12)  # pulls the first end towards the second
-        np.add.at(total, a, f)
-        np.add.at(total, b, -f)
-    total = total[:len(names)]
-    if centre is not None and expansion != 0.0 and len(names):
-        mine = z[:len(names)] - centre
-        r = np.abs(mine)
-        ok = np.asarray(expand, dtype=bool) & (r > 1e-12)
-        total[ok] += EXPANSION_LAWS[law](expansion, r[ok]) * mine[ok] / r[ok]
-    return total
+    and, for those with ``expand`` true, the expansion force (see :class:`NetForce`)."""
+    net = NetForce(names, springs, lengths, expand=expand, centre=centre, expansion=expansion, law=law, core=core,
+                   share=share)
+    return net(np.array(list(map(where.__getitem__, net.slots)), dtype=complex))

@@ -56,9 +56,11 @@ class Island:
         self.space.damping = math.exp(-params.friction / params.mass)
         self.space.iterations = params.solver_iterations
         self.names: list[str] = []
+        self.moving: set[str] = set()  # the names, as a set
         self.bodies: dict[str, pymunk.Body] = {}  # every mass in the space, moving or held still
         self.added: dict[Resolved, None] = {}  # the springs in the island, in the order they joined
-        self.expand = expand
+        self.edge: dict[str, None] = {}  # the free masses its springs reach that it holds still, in order met
+        self.expand, self.centre = expand, centre
         self.hub: pymunk.Body | None = None
         if centre is not None and params.expansion != 0.0:
             self.hub = pymunk.Body(body_type=pymunk.Body.STATIC)
@@ -91,6 +93,8 @@ class Island:
             _add_circle(self.space, body, params)
             body.velocity = _xy(velocities[name])
             self.names.append(name)
+            self.moving.add(name)
+            self.edge.pop(name, None)
             if self.hub is not None and name in self.expand:
                 rest, stiffness = EXPANSION_SPRINGS[params.expansion_law](params.expansion)
                 self.space.add(pymunk.DampedSpring(self.hub, body, (0, 0), (0, 0), rest, stiffness, 0.0))
@@ -98,6 +102,9 @@ class Island:
             if s in self.added:
                 continue
             self.added[s] = None
+            for end in s.ends:
+                if end not in self.fixed and end not in self.moving:
+                    self.edge[end] = None
             if s.kind == "distance":
                 a, b = self._body(s.ends[0], positions), self._body(s.ends[1], positions)
                 for _ in range(self.index.count[s]):
