@@ -54,20 +54,14 @@ class SettleResult:
 class SpringIndex:
     """The springs of a model by the masses they touch, kept up to date cue by cue (:meth:`update`).
 
-    A spring that appears twice counts twice. Every walk over it is in the order of the model's list of
-    springs (:meth:`rank_by`), so the same state gives the same islands however it was reached.
+    A spring that appears twice counts twice. Every walk over it is in the order of the springs' fields
+    (:meth:`Resolved.order`), so the same state gives the same islands however it was reached.
     """
 
     def __init__(self, springs: Sequence[Resolved] = ()) -> None:
         self.count: Counter[Resolved] = Counter()
         self.touching: dict[str, dict[Resolved, None]] = {}
-        self.rank: dict[Resolved, int] = {}  # each spring's place in the model's list: the order of every walk
         self.update(springs, ())
-        self.rank_by(springs)
-
-    def rank_by(self, springs: Sequence[Resolved]) -> None:
-        """Walk springs in the order of ``springs`` (the model's list), whatever order they were added in."""
-        self.rank = {s: i for i, s in reversed(list(enumerate(springs)))}
 
     def update(self, added: Iterable[Resolved], removed: Iterable[Resolved]) -> None:
         """Add and remove springs (each occurrence once)."""
@@ -87,7 +81,7 @@ class SpringIndex:
         chosen: dict[Resolved, None] = {}
         for name in names:
             chosen.update(self.touching.get(name, {}))
-        return sorted(chosen, key=self.rank.__getitem__)
+        return sorted(chosen, key=Resolved.order)
 
     def length(self, spring: Resolved, default: float) -> float:
         """``l`` (m) of an angle spring: the natural length of the stiffest distance spring between its pivot

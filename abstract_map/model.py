@@ -18,8 +18,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from . import errors
 from .clauses import START_ANCHOR, Clause, Locational, Relational, is_anchor, tag_anchor
@@ -31,8 +29,9 @@ from .hierarchy import Hierarchy
 from .params import STIFFNESS, AbstractMapParams
 from .placement import Resolved, place_new_masses
 from .prepositions import LOCATIONAL, TABLE
-from .scales import ScaleKey, learn_scales, natural_lengths
-from .springs import Spring, clause_springs, springs_from_clauses
+from .resolution import ClauseSprings, LooseGroups, Resolver
+from .scales import ScaleKey, learn_scales
+from .springs import Spring, clause_springs
 from .values import T, remembered
 
 __all__ = ["AbstractMap", "FixedPoint", "Observation", "SettleReport", "UnknownPlaceError", "imagined_positions"]
@@ -127,8 +126,10 @@ class AbstractMap:
     # bumped by every change to the clauses or fixed points; with the hierarchy's version it keys _memo
     _version: int = field(default=0, init=False, repr=False, compare=False)
     _memo: dict[str, tuple[Hashable, Any]] = field(default_factory=dict, init=False, repr=False, compare=False)
-    _clause_springs: dict[Clause, list[Spring]] = field(default_factory=dict, init=False, repr=False, compare=False)
-    _resolved_memo: dict[Spring, Resolved] = field(default_factory=dict, init=False, repr=False, compare=False)
+    # the clauses' springs, loose groups and natural lengths, each redoing only what a cue changed (derived)
+    _clause_springs: ClauseSprings = field(default_factory=ClauseSprings, init=False, repr=False, compare=False)
+    _loose: LooseGroups = field(default_factory=LooseGroups, init=False, repr=False, compare=False)
+    _resolver: Resolver = field(default_factory=Resolver, init=False, repr=False, compare=False)
     # what the last settle saw, to tell the next what changed, and the springs by mass (derived, not saved)
     _last_settle: _LastSettle | None = field(default=None, init=False, repr=False, compare=False)
     _index: SpringIndex = field(default_factory=SpringIndex, init=False, repr=False, compare=False)
@@ -334,16 +335,19 @@ class AbstractMap:
         """Every spring of the model (the start's pull on the roots included)."""
         return list(self._cached("springs", self._springs))
 
+    def _springs_of_clauses(self) -> list[Spring]:
+        return self._clause_springs(self.clauses(), self._anchor_kind, {"between_angle": self.params.between_angle})
+
     def _springs(self) -> list[Spring]:
-        # each clause's springs depend on it and its anchors' kinds, which never change: made once
-        springs = springs_from_clauses(self.clauses(), self._anchor_kind, {"between_angle": self.params.between_angle},
-                                       memo=self._clause_springs)
+        """The clauses' springs, then the start's pull on the roots and on each loose group."""
+        springs = list(self._cached("clause springs", self._springs_of_clauses))
+        held = self._loose(self.places(), springs, self.start_roots)
         k = STIFFNESS[self.params.start_stiffness]
         for root in self.start_roots:
             springs.append(Spring("distance", (root, START_ANCHOR), 1.0, k, "start"))
             springs.append(Spring("global_angle", (START_ANCHOR, root), self.start[2], k))
         k = STIFFNESS[self.params.loose_stiffness]
-        for first in _loose_groups(self.places(), springs):
+        for first in held:
             springs.append(Spring("distance", (first, START_ANCHOR), 1.0, k, "start"))
             springs.append(Spring("global_angle", (START_ANCHOR, first), self.start[2], k))
         return springs
@@ -387,19 +391,11 @@ class AbstractMap:
         return list(self._cached("resolved", self._resolved_springs, self.exploration_factor))
 
     def _resolved_springs(self) -> list[Resolved]:
-        levels = self._cached("levels", self._levels)
-        springs = self.springs()
-        learned = learn_scales(springs, levels, self._cached("observed", self._observed_positions).get)
-        lengths = natural_lengths(springs, levels, learned, self.params.scales, self.exploration_factor)
-        memo = self._resolved_memo  # the same spring at the same length: the same value, made once
-        out = []
-        for s, length in zip(springs, lengths):
-            value = length if s.kind == "distance" else s.value
-            made = memo.get(s)
-            if made is None or made.value != value:
-                made = memo[s] = Resolved(s.kind, s.ends, value, s.stiffness)
-            out.append(made)
-        return out
+        front = self._cached("clause springs", self._springs_of_clauses)
+        return self._resolver(front, self._cached("springs", self._springs)[len(front):],
+                              self.hierarchy.levels(), self.hierarchy.version,
+                              self._cached("observed", self._observed_positions), self.params.scales,
+                              self.exploration_factor)
 
     def position(self, place: str) -> np.ndarray:
         """Imagined position (m, world) of a place."""
@@ -457,12 +453,11 @@ class AbstractMap:
             if last is None:
                 return [p for p in self.places() if p in self.positions], []
             changed: Iterable[Resolved] = sorted((Counter(springs) - last.count) + (last.count - Counter(springs)),
-                                                 key=_spring_key)
+                                                 key=Resolved.order)
         else:
             added, removed = current - last.springs, last.springs - current
             self._index.update(added, removed)
-            self._index.rank_by(springs)
-            changed = sorted([*added, *removed], key=_spring_key)  # sets: put in an order no hash decides
+            changed = sorted([*added, *removed], key=Resolved.order)  # sets: put in an order no hash decides
         tested: dict[str, None] = {}
         for spring in changed:
             tested.update(dict.fromkeys(spring.ends))
@@ -554,28 +549,6 @@ EXPLORATION_LAWS = {
     "multiplicative": lambda factor, step: factor * (1.0 + step),
     "additive": lambda factor, step: factor + step,
 }
-
-
-def _loose_groups(places: list[str], springs: list[Spring]) -> list[str]:
-    """The first place (in ``places`` order) of each group that no chain of springs ties to a fixed point."""
-    if not places:
-        return []
-    slot = {p: i for i, p in enumerate(places)}
-    anchor = len(places)  # one node stands for every fixed point
-    pairs = [(slot.get(s.ends[0], anchor), slot.get(e, anchor)) for s in springs for e in s.ends[1:]]
-    rows, cols = np.array(pairs, dtype=int).reshape(-1, 2).T
-    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(anchor + 1, anchor + 1))
-    _, label = connected_components(graph, directed=False)
-    held = label[anchor]
-    firsts: dict[int, str] = {}
-    for place, group in zip(places, label[:anchor].tolist()):
-        if group != held:
-            firsts.setdefault(group, place)
-    return list(firsts.values())
-
-
-def _spring_key(spring: Resolved) -> tuple:
-    return spring.kind, spring.ends, spring.value, spring.stiffness
 
 
 def _clause_names(clause: Clause) -> list[str]:

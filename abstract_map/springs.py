@@ -40,6 +40,8 @@ class Spring(RememberedHash):
     stiffness: float  # N/m (distance) or N/rad (angles)
     scale: str = "place"  # distance springs only: "place", "sign", "label" or "start"
 
+    __hash__ = RememberedHash.__hash__  # in the class body, or the dataclass would write its own
+
 
 AnchorKind = Callable[[str], str]
 """Maps an anchor name to its kind: "label", "sign" or "start"."""

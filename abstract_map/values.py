@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Hashable
-from typing import Any, TypeVar
+from collections.abc import Callable, Hashable, Sequence
+from typing import Any, Generic, TypeVar
 
 T = TypeVar("T")
+S = TypeVar("S")
 
 
 def remembered(cache: dict[str, tuple[Hashable, Any]], key: str, version: Hashable, make: Callable[[], T]) -> T:
@@ -39,3 +40,25 @@ class RememberedHash:
         for name, value in state.items():
             object.__setattr__(self, name, value)
         RememberedHash.__post_init__(self)
+
+
+class GrowingFold(Generic[T, S]):
+    """A fold over a list that mostly grows at its end (the clauses of a model, cue after cue).
+
+    ``fold(state, items)`` folds ``items`` into ``state``, which ``start()`` makes empty. Called with a list
+    whose start is the list it was last called with (the same objects, in order), only the items added since
+    are folded; with any other list it starts again. The state is shared: callers must not change it.
+    """
+
+    def __init__(self, start: Callable[[], S], fold: Callable[[S, Sequence[T]], None]) -> None:
+        self._start, self._fold = start, fold
+        self._items: list[T] = []
+        self._state: S = start()
+
+    def __call__(self, items: Sequence[T]) -> S:
+        done = len(self._items)
+        if len(items) < done or list(items[:done]) != self._items:  # compares identity first: cheap when equal
+            self._state, done = self._start(), 0
+        self._fold(self._state, items[done:])
+        self._items = list(items)
+        return self._state

@@ -1,0 +1,76 @@
+"""Cue-by-cue resolution gives what resolving from scratch gives, and spring hashes are computed once."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from abstract_map.clauses import Relational
+from abstract_map.hierarchy import Hierarchy
+from abstract_map.model import AbstractMap
+from abstract_map.placement import Resolved
+from abstract_map.resolution import LooseGroups
+from abstract_map.scales import learn_scales, natural_lengths
+from abstract_map.springs import Spring, springs_from_clauses
+from abstract_map.values import GrowingFold, RememberedHash
+
+sys.path.append(str(Path(__file__).resolve().parents[2] / "benchmarks"))
+import campus  # noqa: E402
+
+
+def from_scratch(model: AbstractMap) -> tuple[list[Spring], list[float]]:
+    """The model's springs and natural lengths, computed from every clause with nothing remembered."""
+    clauses = springs_from_clauses(model.clauses(), model._anchor_kind,
+                                   {"between_angle": model.params.between_angle})
+    springs = model.springs()
+    assert springs[:len(clauses)] == clauses
+    levels = model.levels()
+    learned = learn_scales(springs, levels, model.observed_positions().get)
+    return springs, natural_lengths(springs, levels, learned, model.params.scales, model.exploration_factor)
+
+
+def test_resolving_cue_by_cue_matches_resolving_from_scratch():
+    walk = campus.generate(150)
+    model = AbstractMap.from_hierarchy(Hierarchy.from_nested(walk.tree), walk.start)
+    for i, (tag, text, pose) in enumerate(walk.cues[:40]):
+        model.observe_tag(tag, text, pose)
+        if i == 20:  # a level added: every scale key may change, so resolution starts again
+            model.add_clauses([Relational("in", "Campus", ("Campus annex",))])
+        if i == 30:
+            model.bump_exploration()
+        springs, lengths = from_scratch(model)
+        resolved = model.resolved_springs()
+        assert [(r.kind, r.ends, r.stiffness) for r in resolved] == [(s.kind, s.ends, s.stiffness) for s in springs]
+        expected = [length if s.kind == "distance" else s.value for s, length in zip(springs, lengths)]
+        assert [r.value for r in resolved] == expected  # exactly: the same products in the same order
+    assert any(model.observed_positions().get(p) is not None for p in walk.truth)
+
+
+def test_loose_groups_follow_the_places_order_and_count_the_held_roots():
+    springs = [Spring("distance", ("a", "b"), 1.0, 1.0), Spring("distance", ("c", "#7"), 1.0, 1.0, "sign"),
+               Spring("distance", ("d", "e"), 1.0, 1.0)]
+    loose = LooseGroups()
+    assert loose(["e", "d", "c", "b", "a", "f"], springs, held=[]) == ["e", "b", "f"]
+    assert loose(["e", "d", "c", "b", "a", "f"], springs, held=["a"]) == ["e", "f"]
+    springs.append(Spring("relative_angle", ("f", "a", "d"), 1.0, 1.0))  # grows: ties f and d's group to a
+    assert loose(["e", "d", "c", "b", "a", "f"], springs, held=["a"]) == []
+    assert loose(["e", "d", "c", "b", "a", "f"], springs[1:], held=[]) == ["e", "b"]  # not a growth: starts again
+
+
+def test_a_growing_fold_folds_only_what_was_added_and_starts_again_otherwise():
+    seen: list[list[int]] = []
+    fold = GrowingFold[int, list[int]](list, lambda state, items: (seen.append(list(items)), state.extend(items)))
+    assert fold([1, 2]) == [1, 2]
+    assert fold([1, 2, 3]) == [1, 2, 3]
+    assert fold([9, 2, 3]) == [9, 2, 3]
+    assert seen == [[1, 2], [3], [9, 2, 3]]
+
+
+def test_springs_keep_the_hash_they_were_made_with():
+    assert Spring.__hash__ is RememberedHash.__hash__
+    assert Resolved.__hash__ is RememberedHash.__hash__
+    spring = Resolved("distance", ("a", "b"), 2.0, 0.5)
+    assert hash(spring) == hash(Resolved("distance", ("a", "b"), 2.0, 0.5))
+    assert spring == Resolved("distance", ("a", "b"), 2.0, 0.5) and np.isfinite(spring.value)
