@@ -34,6 +34,7 @@ from .forces import NetForce
 from .island import Island
 from .params import DynamicsParams
 from .placement import Resolved
+from .values import FIELDS
 
 _CLOCK_EVERY = 16  # steps between looks at the clock under a time cap (a step is tens of microseconds or more)
 _EDGE_EVERY = 32  # steps between tests of the masses held still at the island's edge, besides one at each rest
@@ -55,12 +56,13 @@ class SpringIndex:
     """The springs of a model by the masses they touch, kept up to date cue by cue (:meth:`update`).
 
     A spring that appears twice counts twice. Every walk over it is in the order of the springs' fields
-    (:meth:`Resolved.order`), so the same state gives the same islands however it was reached.
+    (``RememberedHash.fields``), so the same state gives the same islands however it was reached.
     """
 
     def __init__(self, springs: Sequence[Resolved] = ()) -> None:
         self.count: Counter[Resolved] = Counter()
         self.touching: dict[str, dict[Resolved, None]] = {}
+        self._lengths: dict[tuple[str, str], float | None] = {}  # (pivot, turned) -> l, or None: no distance spring
         self.update(springs, ())
 
     def update(self, added: Iterable[Resolved], removed: Iterable[Resolved]) -> None:
@@ -71,28 +73,36 @@ class SpringIndex:
                 del self.count[s]
                 for end in s.ends:
                     self.touching[end].pop(s, None)
+                self._forget_length(s)
         for s in added:
             self.count[s] += 1
             for end in s.ends:
                 self.touching.setdefault(end, {})[s] = None
+            self._forget_length(s)
+
+    def _forget_length(self, s: Resolved) -> None:
+        if s.kind == "distance":
+            self._lengths.pop((s.ends[0], s.ends[1]), None)
+            self._lengths.pop((s.ends[1], s.ends[0]), None)
 
     def around(self, names: Iterable[str]) -> list[Resolved]:
         """Every spring touching one of ``names``, once each."""
         chosen: dict[Resolved, None] = {}
         for name in names:
             chosen.update(self.touching.get(name, {}))
-        return sorted(chosen, key=Resolved.order)
+        return sorted(chosen, key=FIELDS)
 
     def length(self, spring: Resolved, default: float) -> float:
         """``l`` (m) of an angle spring: the natural length of the stiffest distance spring between its pivot
         and the place it turns (global: reference and figure; relative: vertex and its second place)."""
         pivot, turned = spring.ends[-2:]
-        best: Resolved | None = None
-        for s in self.touching.get(pivot, {}):
-            if s.kind == "distance" and turned in s.ends and pivot in s.ends and \
-                    (best is None or s.stiffness > best.stiffness):
-                best = s
-        return default if best is None else best.value
+        if (pivot, turned) not in self._lengths:
+            between = [s for s in self.touching.get(pivot, {}) if s.kind == "distance" and turned in s.ends]
+            # the stiffest; of equals, the first in field order (not the order the index met them in)
+            best = min(between, key=lambda s: (-s.stiffness, s.fields), default=None)
+            self._lengths[pivot, turned] = None if best is None else best.value
+        length = self._lengths[pivot, turned]
+        return default if length is None else length
 
 
 class _Positions(dict):  # type: ignore[type-arg]

@@ -15,6 +15,7 @@ import time
 from collections import Counter
 from collections.abc import Callable, Hashable, Iterable, Mapping
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -32,7 +33,7 @@ from .prepositions import LOCATIONAL, TABLE
 from .resolution import ClauseSprings, LooseGroups, Resolver
 from .scales import ScaleKey, learn_scales
 from .springs import Spring, clause_springs
-from .values import T, remembered
+from .values import FIELDS, GrowingFold, T, remembered
 
 __all__ = ["AbstractMap", "FixedPoint", "Observation", "SettleReport", "UnknownPlaceError", "imagined_positions"]
 
@@ -62,6 +63,22 @@ class FixedPoint:
         self.theta = math.atan2(n * math.sin(self.theta) + math.sin(theta),
                                 n * math.cos(self.theta) + math.cos(theta))
         self.sightings = n + 1
+
+
+class _Mentions:
+    """The places clauses mention (after the hierarchy's), in first-mention order, and each label's anchors."""
+
+    def __init__(self, places: Iterable[str]) -> None:
+        self.names: dict[str, None] = dict.fromkeys(places)
+        self.labels: dict[str, list[str]] = {}
+
+    def take(self, clauses: Iterable[Clause]) -> None:
+        for clause in clauses:
+            if isinstance(clause, Locational) and clause.kind == "label":
+                self.labels.setdefault(clause.toponym, []).append(clause.anchor)
+            for name in _clause_names(clause):
+                if not is_anchor(name):
+                    self.names.setdefault(name, None)
 
 
 @dataclass(frozen=True)
@@ -130,6 +147,8 @@ class AbstractMap:
     _clause_springs: ClauseSprings = field(default_factory=ClauseSprings, init=False, repr=False, compare=False)
     _loose: LooseGroups = field(default_factory=LooseGroups, init=False, repr=False, compare=False)
     _resolver: Resolver = field(default_factory=Resolver, init=False, repr=False, compare=False)
+    _mention_fold: tuple[Hashable, GrowingFold[Clause, _Mentions]] | None = field(default=None, init=False,
+                                                                                  repr=False, compare=False)
     # what the last settle saw, to tell the next what changed, and the springs by mass (derived, not saved)
     _last_settle: _LastSettle | None = field(default=None, init=False, repr=False, compare=False)
     _index: SpringIndex = field(default_factory=SpringIndex, init=False, repr=False, compare=False)
@@ -171,12 +190,19 @@ class AbstractMap:
         return list(self._cached("places", self._places))
 
     def _places(self) -> list[str]:
-        names: dict[str, None] = dict.fromkeys(self.hierarchy.places)  # the hierarchy's clauses name only these
-        for clause in [c for cs in self.cue_clauses.values() for c in cs] + self.loose_clauses:
-            for name in _clause_names(clause):
-                if not is_anchor(name):
-                    names.setdefault(name, None)
+        names = dict(self._mentions().names)
+        for clause in self.loose_clauses:
+            names.update(dict.fromkeys(n for n in _clause_names(clause) if not is_anchor(n)))
         return list(names)
+
+    def _mentions(self) -> _Mentions:
+        """The places and labels that the hierarchy and the cues' clauses mention (loose clauses aside)."""
+        version = self.hierarchy.version
+        if self._mention_fold is None or self._mention_fold[0] != version:  # the hierarchy's places come first
+            places = list(self.hierarchy.places)
+            self._mention_fold = version, GrowingFold[Clause, _Mentions](partial(_Mentions, places), _Mentions.take)
+        clauses = self.clauses()
+        return self._mention_fold[1](clauses[:len(clauses) - len(self.loose_clauses)])
 
     def clauses(self) -> list[Clause]:
         """All clauses: the hierarchy's, then each cue's, then loose ones."""
@@ -365,18 +391,17 @@ class AbstractMap:
         return dict(self._cached("observed", self._observed_positions))
 
     def _observed_positions(self) -> dict[str, np.ndarray]:
-        labels: dict[str, list[np.ndarray]] = {}
-        for clauses in self.cue_clauses.values():
-            for c in clauses:
-                if isinstance(c, Locational) and c.kind == "label":
-                    labels.setdefault(c.toponym, []).append(self.fixed[c.anchor].xy)
-        observed = {name: np.mean(xy, axis=0) for name, xy in labels.items()}
-        observed.update({name: f.xy for name, f in self.fixed.items()})
+        fixed = {name: f.xy for name, f in self.fixed.items()}
+        labels = self._mentions().labels
+        observed = {name: fixed[a[0]] if len(a) == 1 else np.mean([fixed[n] for n in a], axis=0)
+                    for name, a in labels.items()}
+        observed.update(fixed)
         return observed
 
     def observed_position(self, name: str) -> np.ndarray | None:
         """Where a place was observed (mean of its label tags), a fixed point's position, or None."""
-        return self.observed_positions().get(name)
+        xy = self._cached("observed", self._observed_positions).get(name)
+        return None if xy is None else xy.copy()
 
     def is_observed(self, place: str) -> bool:
         """True once a label of ``place`` has been read."""
@@ -453,11 +478,11 @@ class AbstractMap:
             if last is None:
                 return [p for p in self.places() if p in self.positions], []
             changed: Iterable[Resolved] = sorted((Counter(springs) - last.count) + (last.count - Counter(springs)),
-                                                 key=Resolved.order)
+                                                 key=FIELDS)
         else:
             added, removed = current - last.springs, last.springs - current
             self._index.update(added, removed)
-            changed = sorted([*added, *removed], key=Resolved.order)  # sets: put in an order no hash decides
+            changed = sorted([*added, *removed], key=FIELDS)  # sets: put in an order no hash decides
         tested: dict[str, None] = {}
         for spring in changed:
             tested.update(dict.fromkeys(spring.ends))

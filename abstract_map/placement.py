@@ -32,10 +32,6 @@ class Resolved(RememberedHash):
 
     __hash__ = RememberedHash.__hash__  # in the class body, or the dataclass would write its own
 
-    def order(self) -> tuple[str, tuple[str, ...], float, float]:
-        """Its fields, as a sort key: walks over sets of springs follow it, so no hash order decides them."""
-        return self.kind, self.ends, self.value, self.stiffness
-
 
 def _fan_angle(k: int) -> float:
     """The k-th fan offset (rad) in [-pi/2, pi/2), starting straight ahead."""

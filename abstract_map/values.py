@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Hashable, Sequence
+from operator import attrgetter
 from typing import Any, Generic, TypeVar
 
 T = TypeVar("T")
@@ -19,14 +20,18 @@ def remembered(cache: dict[str, tuple[Hashable, Any]], key: str, version: Hashab
 
 
 class RememberedHash:
-    """Mixin for a frozen dataclass: its hash is its fields' hash, computed at construction and never again.
+    """Mixin for a frozen dataclass: its hash is its fields' hash, computed at construction and never again,
+    and ``fields`` is the tuple of its fields (a sort key that no hash order decides). A subclass must say
+    ``__hash__ = RememberedHash.__hash__`` in its body, or the dataclass writes its own.
 
     The hash is not pickled (string hashes differ between processes); it is computed anew on unpickling.
     """
 
     def __post_init__(self) -> None:
-        # a dataclass's __init__ sets its fields in order, so before "_hash" the instance dict holds just them
-        object.__setattr__(self, "_hash", hash(tuple(self.__dict__.values())))
+        # a dataclass's __init__ sets its fields in order, so before "fields" the instance dict holds just them
+        fields = tuple(self.__dict__.values())
+        object.__setattr__(self, "fields", fields)
+        object.__setattr__(self, "_hash", hash(fields))
 
     def __hash__(self) -> int:
         return self._hash  # type: ignore[attr-defined, no-any-return]
@@ -34,12 +39,16 @@ class RememberedHash:
     def __getstate__(self) -> dict[str, Any]:
         state = dict(self.__dict__)
         state.pop("_hash", None)
+        state.pop("fields", None)
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         for name, value in state.items():
             object.__setattr__(self, name, value)
         RememberedHash.__post_init__(self)
+
+
+FIELDS = attrgetter("fields")  # the sort key of a RememberedHash value
 
 
 class GrowingFold(Generic[T, S]):

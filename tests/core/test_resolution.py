@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pickle
 import sys
 from pathlib import Path
 
@@ -74,3 +75,19 @@ def test_springs_keep_the_hash_they_were_made_with():
     spring = Resolved("distance", ("a", "b"), 2.0, 0.5)
     assert hash(spring) == hash(Resolved("distance", ("a", "b"), 2.0, 0.5))
     assert spring == Resolved("distance", ("a", "b"), 2.0, 0.5) and np.isfinite(spring.value)
+
+
+def test_a_pickled_model_goes_on_settling_exactly_as_the_original():
+    walk = campus.generate(150)
+    model = AbstractMap.from_hierarchy(Hierarchy.from_nested(walk.tree), walk.start)
+    model.settle()
+    for tag, text, pose in walk.cues[:10]:
+        model.observe_tag(tag, text, pose)
+        model.settle()
+    copy = pickle.loads(pickle.dumps(model))
+    for tag, text, pose in walk.cues[10:20]:
+        for m in (model, copy):
+            m.observe_tag(tag, text, pose)
+            m.settle()
+    assert model.positions.keys() == copy.positions.keys()
+    assert all(np.array_equal(model.positions[p], copy.positions[p]) for p in model.positions)
