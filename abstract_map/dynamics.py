@@ -105,7 +105,7 @@ class SpringIndex:
         return default if length is None else length
 
 
-class _Positions(dict):  # type: ignore[type-arg]
+class ComplexPositions(dict):  # type: ignore[type-arg]
     """Complex positions (m) by name, filled from plain ``(x, y)`` mappings when first asked for."""
 
     def __init__(self, *sources: Mapping[str, Any]) -> None:
@@ -124,22 +124,26 @@ class _Positions(dict):  # type: ignore[type-arg]
 def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndarray],
            fixed: Mapping[str, np.ndarray], springs: Sequence[Resolved] | SpringIndex, *,
            active: Iterable[str], expand: Iterable[str], centre: np.ndarray | None, params: DynamicsParams,
-           tested: Iterable[str] = (), max_steps: int | None = None, deadline: float | None = None) -> SettleResult:
+           tested: Iterable[str] = (), tested_forces: Mapping[str, complex] | None = None,
+           max_steps: int | None = None, deadline: float | None = None) -> SettleResult:
     """Settle the masses ``active``, those of ``tested`` that fail the acceleration test, and whatever they
     disturb; every other free mass of ``positions`` is held still until the net force on it would accelerate
     it at ``params.wake_acceleration`` or more.
+
+    ``tested_forces``, if given, is the net spring force (N, complex) on each of ``tested`` as they stand
+    (``resolution.SpringField``), which spares building it from the springs around them.
 
     Stops settled, or at a cap: ``max_steps`` steps in all (default ``params.max_iterations``) or the
     ``time.perf_counter()`` reading ``deadline`` (default none), whichever comes first."""
     step_cap = params.max_iterations if max_steps is None else max_steps
     index = springs if isinstance(springs, SpringIndex) else SpringIndex(springs)
-    where = _Positions(positions, fixed)
-    speed = _Positions(velocities, _Zero())
+    where = ComplexPositions(positions, fixed)
+    speed = ComplexPositions(velocities, _Zero())
     expand = expand if isinstance(expand, (set, frozenset, dict)) else set(expand)
     names = list(dict.fromkeys(n for n in active if n in positions))
     inside = set(names)
     names += _failing([n for n in dict.fromkeys(tested) if n in positions and n not in inside], index, where,
-                      expand, centre, params)
+                      expand, centre, params, tested_forces)
     island = Island(index, fixed, expand=expand, centre=centre, params=params)
     steps, joins, stopped_by = 0, 0, ""
     dv_limit = params.settle_acceleration * params.dt
@@ -230,12 +234,19 @@ def _net_force(names: Sequence[str], index: SpringIndex, expanding: Collection[s
 
 
 def _failing(names: Sequence[str], index: SpringIndex, where: Mapping[str, complex], expanding: Collection[str],
-             centre: np.ndarray | None, params: DynamicsParams) -> list[str]:
+             centre: np.ndarray | None, params: DynamicsParams,
+             spring_force: Mapping[str, complex] | None = None) -> list[str]:
     """Those of ``names`` (masses held still) on which the net force would accelerate them at
-    ``params.wake_acceleration`` or more, in ``names`` order."""
+    ``params.wake_acceleration`` or more, in ``names`` order; ``spring_force``, if given, holds each one's net
+    spring force (N), to which the expansion force is added."""
     if not names:
         return []
-    net = _net_force(names, index, expanding, centre, params)
+    if spring_force is None:
+        net = _net_force(names, index, expanding, centre, params)
+    else:
+        net = _net_force(names, SpringIndex(), expanding, centre, params)  # the expansion force alone
     force = net(np.array(list(map(where.__getitem__, net.slots)), dtype=complex))
+    if spring_force is not None:
+        force = force + np.array([spring_force[n] for n in names], dtype=complex)
     limit = params.wake_acceleration * params.mass
     return [e for e, f in zip(names, force) if abs(f) >= limit]

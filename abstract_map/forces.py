@@ -34,6 +34,9 @@ def wrap(angle: np.ndarray) -> np.ndarray:
     return (angle + np.pi) % (2 * np.pi) - np.pi
 
 
+ANGLE_KINDS = {"global_angle": 1, "relative_angle": 2}  # kind codes of AngleSprings.of_arrays; 0: distance
+
+
 class AngleSprings:
     """Angle springs as one vectorised force field over ``n`` masses.
 
@@ -46,28 +49,45 @@ class AngleSprings:
 
     def __init__(self, n: int, springs: Sequence[Resolved], ends: Sequence[Sequence[int]], lengths: Sequence[float],
                  *, core: float, share: float) -> None:
+        kind = np.array([ANGLE_KINDS.get(s.kind, 0) for s in springs], dtype=np.int8)
+        slots = np.zeros((len(springs), 3), dtype=int)
+        for i, x in enumerate(ends):
+            slots[i, :len(x)] = x
+        self._build(n, kind, slots, np.array([s.value for s in springs], dtype=float),
+                    np.array([s.stiffness for s in springs], dtype=float), np.asarray(lengths, dtype=float),
+                    core=core, share=share)
+
+    @classmethod
+    def of_arrays(cls, n: int, kind: np.ndarray, slots: np.ndarray, target: np.ndarray, stiffness: np.ndarray,
+                  length: np.ndarray, *, core: float, share: float) -> AngleSprings:
+        """The same from arrays, one row a spring: ``kind`` 1 global, 2 relative, 0 not an angle spring
+        (skipped); ``slots`` (rows of 3; a global spring uses the first 2); ``target`` rad; ``stiffness``
+        N/rad; ``length`` l, m."""
+        springs = cls.__new__(cls)
+        springs._build(n, kind, slots, target, stiffness, length, core=core, share=share)
+        return springs
+
+    def _build(self, n: int, kind: np.ndarray, slots: np.ndarray, target: np.ndarray, stiffness: np.ndarray,
+               length: np.ndarray, *, core: float, share: float) -> None:
         self.n = n
-        g = [i for i, s in enumerate(springs) if s.kind == "global_angle"]
-        r = [i for i, s in enumerate(springs) if s.kind == "relative_angle"]
-        order = g + r
+        g, r = np.flatnonzero(kind == 1), np.flatnonzero(kind == 2)
+        order = np.concatenate([g, r]).astype(int)
         n_g, n_r = len(g), len(r)
-        e = [list(ends[i]) for i in order]
         # pairs: every global spring's (reference -> figure), then every relative spring's (vertex -> a), then
         # its (vertex -> b); the index n_pairs is the x axis (a global spring's first pair)
-        self.heads = np.array([x[1] for x in e[:n_g]] + [x[0] for x in e[n_g:]] + [x[2] for x in e[n_g:]], dtype=int)
-        self.tails = np.array([x[0] for x in e[:n_g]] + [x[1] for x in e[n_g:]] * 2, dtype=int)
+        slots = slots.reshape(-1, 3)
+        self.heads = np.concatenate([slots[g, 1], slots[r, 0], slots[r, 2]]).astype(int)
+        self.tails = np.concatenate([slots[g, 0], slots[r, 1], slots[r, 1]]).astype(int)
         n_pairs = len(self.heads)
         self.first = np.concatenate([np.full(n_g, n_pairs), n_g + np.arange(n_r)]).astype(int)
         self.second = np.concatenate([np.arange(n_g), n_g + n_r + np.arange(n_r)]).astype(int)
         pair_spring = np.concatenate([np.arange(n_g), n_g + np.arange(n_r), n_g + np.arange(n_r)]).astype(int)
         self.pair_spring = pair_spring
-        target = np.array([springs[i].value for i in order], dtype=float)
-        self.turn = np.exp(-1j * target)  # a spring's error is the angle of second * conj(first) * turn
-        length = np.array([lengths[i] for i in order], dtype=float)
-        torque = np.array([springs[i].stiffness for i in order], dtype=float) * length  # N m/rad
+        self.turn = np.exp(-1j * target[order])  # a spring's error is the angle of second * conj(first) * turn
+        torque = stiffness[order] * length[order]  # N m/rad
         # each pair's push per radian of error: the second pair is pushed back, the first forward
         self.gain = np.concatenate([-np.ones(n_g), np.ones(n_r), -np.ones(n_r)]) * torque[pair_spring]
-        self.floor = np.maximum(core, share * length)[pair_spring]  # m, per pair
+        self.floor = np.maximum(core, share * length[order])[pair_spring]  # m, per pair
         self.ends = np.concatenate([self.heads, self.tails])
         self._d = np.ones(n_pairs + 1, dtype=complex)  # scratch: the pairs' vectors, then the x axis
 
@@ -131,6 +151,23 @@ class NetForce:
             ok = self.expand & (r > 1e-12)
             total[ok] += law(c, r[ok]) * mine[ok] / r[ok]
         return total
+
+
+def spring_forces(n: int, kind: np.ndarray, slots: np.ndarray, value: np.ndarray, stiffness: np.ndarray,
+                  length: np.ndarray, z: np.ndarray, *, core: float, share: float) -> np.ndarray:
+    """Net force (N, complex) of springs given as arrays on each of ``n`` slots at complex positions ``z`` (m):
+    ``kind`` 0 distance (``value`` its natural length, m), 1 global and 2 relative angle (``value`` rad,
+    ``length`` l, m); ``slots`` rows of 3 (distance and global springs use the first 2)."""
+    total = AngleSprings.of_arrays(n, kind, slots, value, stiffness, length, core=core, share=share)(z)
+    distance = np.flatnonzero(kind == 0)
+    if len(distance):
+        a, b = slots[distance, 0], slots[distance, 1]
+        d = z[b] - z[a]
+        r = np.abs(d)
+        f = stiffness[distance] * (r - value[distance]) * d / np.maximum(r, 1e-12)  # pulls a towards b
+        total += np.bincount(a, f.real, n) + 1j * np.bincount(a, f.imag, n)
+        total -= np.bincount(b, f.real, n) + 1j * np.bincount(b, f.imag, n)
+    return total
 
 
 def forces_on(names: Sequence[str], springs: Sequence[Resolved], where: Mapping[str, complex],

@@ -22,7 +22,7 @@ import numpy as np
 
 from . import errors
 from .clauses import START_ANCHOR, Clause, Locational, Relational, is_anchor, tag_anchor
-from .dynamics import SpringIndex
+from .dynamics import ComplexPositions, SpringIndex
 from .dynamics import settle as run_dynamics
 from .errors import CueError, ModelError, UnknownPlaceError
 from .grammar import Anchor, parse_cue
@@ -30,7 +30,7 @@ from .hierarchy import Hierarchy
 from .params import STIFFNESS, AbstractMapParams
 from .placement import Resolved, place_new_masses
 from .prepositions import LOCATIONAL, TABLE
-from .resolution import ClauseSprings, LooseGroups, Resolver
+from .resolution import ClauseSprings, LooseGroups, Resolver, SpringField
 from .scales import ScaleKey, learn_scales
 from .springs import Spring, clause_springs
 from .values import FIELDS, GrowingFold, T, remembered
@@ -147,6 +147,7 @@ class AbstractMap:
     _clause_springs: ClauseSprings = field(default_factory=ClauseSprings, init=False, repr=False, compare=False)
     _loose: LooseGroups = field(default_factory=LooseGroups, init=False, repr=False, compare=False)
     _resolver: Resolver = field(default_factory=Resolver, init=False, repr=False, compare=False)
+    _field: SpringField = field(default_factory=SpringField, init=False, repr=False, compare=False)
     _mention_fold: tuple[Hashable, GrowingFold[Clause, _Mentions]] | None = field(default=None, init=False,
                                                                                   repr=False, compare=False)
     # what the last settle saw, to tell the next what changed, and the springs by mass (derived, not saved)
@@ -541,9 +542,16 @@ class AbstractMap:
             {p for p in places if p not in parents}
         fixed = {n: f.xy for n, f in self.fixed.items()}
         active, tested = self._disturbed(springs, new, fixed)
+        dynamics = self.params.dynamics
+        if tested:
+            front = self._cached("clause springs", self._springs_of_clauses)
+            pull = self._field(front, springs, ComplexPositions(self.positions, fixed), tested,
+                               default_length=dynamics.angle_length, core=dynamics.angle_core,
+                               share=dynamics.angle_core_share)
         result = run_dynamics(self.positions, self.velocities, fixed, self._index, active=active, tested=tested,
-                              expand=expand, centre=self.explored_centre, params=self.params.dynamics,
-                              max_steps=max_steps, deadline=None if max_s is None else began + max_s)
+                              tested_forces=dict(zip(tested, pull.tolist())) if tested else None, expand=expand,
+                              centre=self.explored_centre, params=dynamics, max_steps=max_steps,
+                              deadline=None if max_s is None else began + max_s)
         bad = [n for n, xy in result.positions.items() if not np.all(np.abs(xy) <= errors.COORDINATE_LIMIT_M)]
         if bad:  # never expected with checked inputs: refuse rather than hand out NaN
             for name in placed:

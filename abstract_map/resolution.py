@@ -26,6 +26,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from .clauses import Clause, is_anchor
+from .forces import ANGLE_KINDS, spring_forces
 from .params import ScaleDefaults
 from .placement import Resolved
 from .scales import LEARNABLE, ScaleKey, default_scale, learn_scales, scale_key
@@ -188,3 +189,66 @@ class Resolver:
 def _resolved(spring: Spring, value: float) -> Resolved:
     return Resolved(spring.kind, spring.ends, value, spring.stiffness)
 
+
+
+@dataclass
+class _Structure:
+    """The springs' kinds, ends and stiffnesses as arrays, appended as springs arrive."""
+
+    slot: dict[str, int] = field(default_factory=dict)  # every end's slot
+    kind: array = field(default_factory=lambda: array("b"))  # 0 distance, 1 global, 2 relative angle
+    slots: array = field(default_factory=lambda: array("q"))  # 3 per spring (distance and global use 2)
+    stiffness: array = field(default_factory=lambda: array("d"))
+    pairs: dict[frozenset[str], list[int]] = field(default_factory=dict)  # distance springs between two masses
+    angles: list[tuple[int, frozenset[str]]] = field(default_factory=list)  # angle spring, (pivot, place turned)
+    count: int = 0
+
+    def take(self, springs: Sequence[Spring | Resolved]) -> None:
+        for s in springs:
+            ends = [self.slot.setdefault(e, len(self.slot)) for e in s.ends]
+            self.slots.extend(ends + [0] * (3 - len(ends)))
+            self.kind.append(ANGLE_KINDS.get(s.kind, 0))
+            self.stiffness.append(s.stiffness)
+            pair = frozenset(s.ends[-2:])
+            if s.kind == "distance":
+                self.pairs.setdefault(pair, []).append(self.count)
+            else:
+                self.angles.append((self.count, pair))
+            self.count += 1
+
+
+class SpringField:
+    """The net force of every spring of a model on any of its masses, all springs evaluated at once from
+    arrays kept cue by cue: what a settle needs to test many held-still masses (``forces.forces_on`` gives
+    the same force, from the springs around the masses asked about)."""
+
+    def __init__(self) -> None:
+        self._fold = GrowingFold[Spring, _Structure](_Structure, _Structure.take)
+
+    def __call__(self, front: Sequence[Spring], resolved: Sequence[Resolved], where: Mapping[str, complex],
+                 names: Sequence[str], *, default_length: float, core: float, share: float) -> np.ndarray:
+        """Net spring force (N, complex) on each of ``names`` at complex positions ``where`` (m).
+
+        ``resolved``: the model's resolved springs, whose first ``len(front)`` are ``front`` resolved (the
+        springs that mostly grow at their end) and the rest a few made anew each time."""
+        fixed = self._fold(front)
+        tail = _Structure(slot=fixed.slot, count=len(front))  # the tail's own arrays; slots shared
+        tail.take(resolved[len(front):])
+        n = len(fixed.slot)
+        kind = np.concatenate([np.frombuffer(fixed.kind, dtype=np.int8), np.frombuffer(tail.kind, dtype=np.int8)])
+        slots = np.concatenate([np.frombuffer(fixed.slots, dtype=np.int64),
+                                np.frombuffer(tail.slots, dtype=np.int64)]).reshape(-1, 3)
+        stiffness = np.concatenate([np.frombuffer(fixed.stiffness), np.frombuffer(tail.stiffness)])
+        value = np.array([s.value for s in resolved], dtype=float)
+        length = np.zeros(len(resolved))
+        for i, pair in fixed.angles + tail.angles:  # l: the stiffest distance spring's length (ties: field order)
+            between = fixed.pairs.get(pair, []) + tail.pairs.get(pair, [])
+            if not between:
+                length[i] = default_length
+            elif len(between) == 1:
+                length[i] = value[between[0]]
+            else:
+                length[i] = min((resolved[j] for j in between), key=lambda s: (-s.stiffness, s.fields)).value
+        z = np.array([where[name] for name in fixed.slot], dtype=complex)
+        total = np.append(spring_forces(n, kind, slots, value, stiffness, length, z, core=core, share=share), 0j)
+        return total[np.array([fixed.slot.get(name, n) for name in names], dtype=int)]

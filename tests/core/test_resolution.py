@@ -9,10 +9,12 @@ from pathlib import Path
 import numpy as np
 
 from abstract_map.clauses import Relational
+from abstract_map.dynamics import ComplexPositions, SpringIndex
+from abstract_map.forces import forces_on
 from abstract_map.hierarchy import Hierarchy
 from abstract_map.model import AbstractMap
 from abstract_map.placement import Resolved
-from abstract_map.resolution import LooseGroups
+from abstract_map.resolution import LooseGroups, SpringField
 from abstract_map.scales import learn_scales, natural_lengths
 from abstract_map.springs import Spring, springs_from_clauses
 from abstract_map.values import GrowingFold, RememberedHash
@@ -91,3 +93,30 @@ def test_a_pickled_model_goes_on_settling_exactly_as_the_original():
             m.settle()
     assert model.positions.keys() == copy.positions.keys()
     assert all(np.array_equal(model.positions[p], copy.positions[p]) for p in model.positions)
+
+
+def test_the_spring_field_gives_each_mass_the_net_force_its_own_springs_give():
+    walk = campus.generate(150)
+    model = AbstractMap.from_hierarchy(Hierarchy.from_nested(walk.tree), walk.start)
+    model.settle()
+    for tag, text, pose in walk.cues[:25]:
+        model.observe_tag(tag, text, pose)
+        model.settle()
+    rng = np.random.default_rng(3)
+    for name in model.positions:  # away from rest, so that every spring pulls
+        model.positions[name] = model.positions[name] + rng.normal(0.0, 2.0, 2)
+    springs = model.resolved_springs()
+    index = SpringIndex(springs)
+    where = ComplexPositions(model.positions, {n: f.xy for n, f in model.fixed.items()})
+    names = list(model.positions)
+    params = model.params.dynamics
+    around = [s for s in index.around(names) for _ in range(index.count[s])]
+    expected = forces_on(names, around, where, [index.length(s, params.angle_length) for s in around],
+                         expand=[False] * len(names), centre=None, expansion=0.0, law="constant",
+                         core=params.angle_core, share=params.angle_core_share)
+    field = SpringField()
+    front = model._cached("clause springs", model._springs_of_clauses)
+    got = field(front, springs, where, names, default_length=params.angle_length, core=params.angle_core,
+                share=params.angle_core_share)
+    assert np.median(np.abs(expected)) > 0.01  # not at rest: the comparison means something
+    assert np.allclose(got, expected, rtol=1e-9, atol=1e-12)
