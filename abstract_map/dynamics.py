@@ -26,7 +26,7 @@ import time
 from collections import Counter
 from collections.abc import Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -35,6 +35,9 @@ from .island import Island
 from .params import DynamicsParams
 from .placement import Resolved
 from .values import FIELDS
+
+if TYPE_CHECKING:
+    from .resolution import SpringField
 
 _CLOCK_EVERY = 16  # steps between looks at the clock under a time cap (a step is tens of microseconds or more)
 _EDGE_EVERY = 32  # steps between tests of the masses held still at the island's edge, besides one at each rest
@@ -124,14 +127,14 @@ class ComplexPositions(dict):  # type: ignore[type-arg]
 def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndarray],
            fixed: Mapping[str, np.ndarray], springs: Sequence[Resolved] | SpringIndex, *,
            active: Iterable[str], expand: Iterable[str], centre: np.ndarray | None, params: DynamicsParams,
-           tested: Iterable[str] = (), tested_forces: Mapping[str, complex] | None = None,
-           max_steps: int | None = None, deadline: float | None = None) -> SettleResult:
+           tested: Iterable[str] = (), field: SpringField | None = None, max_steps: int | None = None,
+           deadline: float | None = None) -> SettleResult:
     """Settle the masses ``active``, those of ``tested`` that fail the acceleration test, and whatever they
     disturb; every other free mass of ``positions`` is held still until the net force on it would accelerate
     it at ``params.wake_acceleration`` or more.
 
-    ``tested_forces``, if given, is the net spring force (N, complex) on each of ``tested`` as they stand
-    (``resolution.SpringField``), which spares building it from the springs around them.
+    ``field``, if given, is the same springs as arrays (a prepared ``resolution.SpringField``), from which
+    the forces on masses held still are gathered instead of built spring by spring.
 
     Stops settled, or at a cap: ``max_steps`` steps in all (default ``params.max_iterations``) or the
     ``time.perf_counter()`` reading ``deadline`` (default none), whichever comes first."""
@@ -143,7 +146,7 @@ def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndar
     names = list(dict.fromkeys(n for n in active if n in positions))
     inside = set(names)
     names += _failing([n for n in dict.fromkeys(tested) if n in positions and n not in inside], index, where,
-                      expand, centre, params, tested_forces)
+                      expand, centre, params, field)
     island = Island(index, fixed, expand=expand, centre=centre, params=params)
     steps, joins, stopped_by = 0, 0, ""
     dv_limit = params.settle_acceleration * params.dt
@@ -155,7 +158,7 @@ def settle(positions: Mapping[str, np.ndarray], velocities: Mapping[str, np.ndar
         z, velocity = island.read()
         if not np.allclose(z, [where[n] for n in island.names]):
             raise RuntimeError("pymunk returned bodies in an unexpected order")
-        woken = _EdgeTest(island, index, where, params)
+        woken = _EdgeTest(island, index, where, params, field)
         while True:
             if steps >= step_cap:
                 stopped_by = "steps"
@@ -202,10 +205,10 @@ class _EdgeTest:
     """The wake test of the masses an island holds still at its edge, made once for each shape of the island
     (:meth:`Island.join` changes it): called with the island's positions, it returns those that fail."""
 
-    def __init__(self, island: Island, index: SpringIndex, where: Mapping[str, complex],
-                 params: DynamicsParams) -> None:
+    def __init__(self, island: Island, index: SpringIndex, where: Mapping[str, complex], params: DynamicsParams,
+                 field: SpringField | None = None) -> None:
         self.edge = list(island.edge)
-        self.net = _net_force(self.edge, index, island.expand, island.centre, params)
+        self.net = _net_force(self.edge, index, island.expand, island.centre, params, field)
         inside = {name: i for i, name in enumerate(island.names)}
         mine = [(k, inside[n]) for k, n in enumerate(self.net.slots) if n in inside]
         self.slot, self.of_island = (np.array(x, dtype=int) for x in zip(*mine)) if mine else \
@@ -222,31 +225,27 @@ class _EdgeTest:
 
 
 def _net_force(names: Sequence[str], index: SpringIndex, expanding: Collection[str], centre: np.ndarray | None,
-               params: DynamicsParams) -> NetForce:
-    """The net force on ``names`` from every spring touching them (each as often as it occurs) and expansion."""
+               params: DynamicsParams, field: SpringField | None = None) -> NetForce:
+    """The net force on ``names`` from every spring touching them (each as often as it occurs) and expansion;
+    gathered from ``field`` (a prepared ``resolution.SpringField``) if given."""
+    laws = {"expand": [e in expanding for e in names],
+            "centre": None if centre is None else complex(float(centre[0]), float(centre[1])),
+            "expansion": params.expansion, "law": params.expansion_law, "core": params.angle_core,
+            "share": params.angle_core_share}
+    if field is not None:
+        return field.around(names, **laws)
     around = [s for s in index.around(names) for _ in range(index.count[s])]
     return NetForce(names, around, [index.length(s, params.angle_length) if s.kind != "distance" else 0.0
-                                    for s in around],
-                    expand=[e in expanding for e in names],
-                    centre=None if centre is None else complex(float(centre[0]), float(centre[1])),
-                    expansion=params.expansion, law=params.expansion_law, core=params.angle_core,
-                    share=params.angle_core_share)
+                                    for s in around], **laws)
 
 
 def _failing(names: Sequence[str], index: SpringIndex, where: Mapping[str, complex], expanding: Collection[str],
-             centre: np.ndarray | None, params: DynamicsParams,
-             spring_force: Mapping[str, complex] | None = None) -> list[str]:
+             centre: np.ndarray | None, params: DynamicsParams, field: SpringField | None = None) -> list[str]:
     """Those of ``names`` (masses held still) on which the net force would accelerate them at
-    ``params.wake_acceleration`` or more, in ``names`` order; ``spring_force``, if given, holds each one's net
-    spring force (N), to which the expansion force is added."""
+    ``params.wake_acceleration`` or more, in ``names`` order."""
     if not names:
         return []
-    if spring_force is None:
-        net = _net_force(names, index, expanding, centre, params)
-    else:
-        net = _net_force(names, SpringIndex(), expanding, centre, params)  # the expansion force alone
+    net = _net_force(names, index, expanding, centre, params, field)
     force = net(np.array(list(map(where.__getitem__, net.slots)), dtype=complex))
-    if spring_force is not None:
-        force = force + np.array([spring_force[n] for n in names], dtype=complex)
     limit = params.wake_acceleration * params.mass
     return [e for e, f in zip(names, force) if abs(f) >= limit]

@@ -121,15 +121,36 @@ class NetForce:
         for s in springs:
             for end in s.ends:
                 slot.setdefault(end, len(slot))
-        self.slots = list(slot)
+        rows = np.zeros((len(springs), 3), dtype=int)
+        for i, s in enumerate(springs):
+            rows[i, :len(s.ends)] = [slot[e] for e in s.ends]
+        self._build(names, list(slot), np.array([ANGLE_KINDS.get(s.kind, 0) for s in springs], dtype=np.int8), rows,
+                    np.array([s.value for s in springs], dtype=float),
+                    np.array([s.stiffness for s in springs], dtype=float), np.asarray(lengths, dtype=float),
+                    expand=expand, centre=centre, expansion=expansion, law=law, core=core, share=share)
+
+    @classmethod
+    def of_arrays(cls, names: Sequence[str], slots: Sequence[str], kind: np.ndarray, rows: np.ndarray,
+                  value: np.ndarray, stiffness: np.ndarray, length: np.ndarray, *, expand: Sequence[bool],
+                  centre: complex | None, expansion: float, law: str, core: float, share: float) -> NetForce:
+        """The same from arrays (as :func:`spring_forces` takes them), ``rows`` indexing ``slots``, whose
+        first entries are ``names``."""
+        net = cls.__new__(cls)
+        net._build(names, slots, kind, rows, value, stiffness, length, expand=expand, centre=centre,
+                   expansion=expansion, law=law, core=core, share=share)
+        return net
+
+    def _build(self, names: Sequence[str], slots: Sequence[str], kind: np.ndarray, rows: np.ndarray,
+               value: np.ndarray, stiffness: np.ndarray, length: np.ndarray, *, expand: Sequence[bool],
+               centre: complex | None, expansion: float, law: str, core: float, share: float) -> None:
+        self.slots = list(slots)
         self.n = len(names)
-        self.angles = AngleSprings(len(slot), springs, [[slot[e] for e in s.ends] if s.kind != "distance" else []
-                                                        for s in springs], lengths, core=core, share=share)
-        distance = [s for s in springs if s.kind == "distance"]
-        self.a = np.array([slot[s.ends[0]] for s in distance], dtype=int)
-        self.b = np.array([slot[s.ends[1]] for s in distance], dtype=int)
-        self.stiffness = np.array([s.stiffness for s in distance], dtype=float)
-        self.rest = np.array([s.value for s in distance], dtype=float)
+        rows = rows.reshape(-1, 3)
+        self.angles = AngleSprings.of_arrays(len(self.slots), kind, rows, value, stiffness, length, core=core,
+                                             share=share)
+        distance = np.flatnonzero(kind == 0)
+        self.a, self.b = rows[distance, 0], rows[distance, 1]
+        self.stiffness, self.rest = stiffness[distance], value[distance]
         self.expand = np.asarray(expand, dtype=bool).reshape(-1)
         self.push = None if centre is None or expansion == 0.0 or not self.expand.any() else \
             (centre, EXPANSION_LAWS[law], expansion)

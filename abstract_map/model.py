@@ -22,7 +22,7 @@ import numpy as np
 
 from . import errors
 from .clauses import START_ANCHOR, Clause, Locational, Relational, is_anchor, tag_anchor
-from .dynamics import ComplexPositions, SpringIndex
+from .dynamics import SpringIndex
 from .dynamics import settle as run_dynamics
 from .errors import CueError, ModelError, UnknownPlaceError
 from .grammar import Anchor, parse_cue
@@ -542,15 +542,11 @@ class AbstractMap:
             {p for p in places if p not in parents}
         fixed = {n: f.xy for n, f in self.fixed.items()}
         active, tested = self._disturbed(springs, new, fixed)
-        dynamics = self.params.dynamics
-        if tested:
-            front = self._cached("clause springs", self._springs_of_clauses)
-            pull = self._field(front, springs, ComplexPositions(self.positions, fixed), tested,
-                               default_length=dynamics.angle_length, core=dynamics.angle_core,
-                               share=dynamics.angle_core_share)
+        self._field.prepare(self._cached("clause springs", self._springs_of_clauses), springs,
+                            default_length=self.params.dynamics.angle_length)
         result = run_dynamics(self.positions, self.velocities, fixed, self._index, active=active, tested=tested,
-                              tested_forces=dict(zip(tested, pull.tolist())) if tested else None, expand=expand,
-                              centre=self.explored_centre, params=dynamics, max_steps=max_steps,
+                              field=self._field, expand=expand, centre=self.explored_centre,
+                              params=self.params.dynamics, max_steps=max_steps,
                               deadline=None if max_s is None else began + max_s)
         bad = [n for n, xy in result.positions.items() if not np.all(np.abs(xy) <= errors.COORDINATE_LIMIT_M)]
         if bad:  # never expected with checked inputs: refuse rather than hand out NaN

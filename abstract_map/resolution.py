@@ -26,7 +26,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from .clauses import Clause, is_anchor
-from .forces import ANGLE_KINDS, spring_forces
+from .forces import ANGLE_KINDS, NetForce
 from .params import ScaleDefaults
 from .placement import Resolved
 from .scales import LEARNABLE, ScaleKey, default_scale, learn_scales, scale_key
@@ -201,12 +201,15 @@ class _Structure:
     stiffness: array = field(default_factory=lambda: array("d"))
     pairs: dict[frozenset[str], list[int]] = field(default_factory=dict)  # distance springs between two masses
     angles: list[tuple[int, frozenset[str]]] = field(default_factory=list)  # angle spring, (pivot, place turned)
+    incident: dict[int, list[int]] = field(default_factory=dict)  # slot -> the springs touching it
     count: int = 0
 
     def take(self, springs: Sequence[Spring | Resolved]) -> None:
         for s in springs:
             ends = [self.slot.setdefault(e, len(self.slot)) for e in s.ends]
             self.slots.extend(ends + [0] * (3 - len(ends)))
+            for end in ends:
+                self.incident.setdefault(end, []).append(self.count)
             self.kind.append(ANGLE_KINDS.get(s.kind, 0))
             self.stiffness.append(s.stiffness)
             pair = frozenset(s.ends[-2:])
@@ -218,26 +221,28 @@ class _Structure:
 
 
 class SpringField:
-    """The net force of every spring of a model on any of its masses, all springs evaluated at once from
-    arrays kept cue by cue: what a settle needs to test many held-still masses (``forces.forces_on`` gives
-    the same force, from the springs around the masses asked about)."""
+    """Every spring of a model as arrays, kept cue by cue, for the forces a settle needs on masses held
+    still: :meth:`around` gives the springs around some masses as a ``forces.NetForce``, gathered from the
+    arrays (the same force ``forces.forces_on`` builds from the springs themselves, spring by spring).
+    :meth:`prepare` takes the model's springs before each settle."""
 
     def __init__(self) -> None:
         self._fold = GrowingFold[Spring, _Structure](_Structure, _Structure.take)
+        self._slot: dict[str, int] = {}
+        self._names: list[str] = []
+        self._parts: tuple[_Structure, _Structure] = (_Structure(), _Structure())
+        self._arrays: tuple[np.ndarray, ...] = ()
 
-    def __call__(self, front: Sequence[Spring], resolved: Sequence[Resolved], where: Mapping[str, complex],
-                 names: Sequence[str], *, default_length: float, core: float, share: float) -> np.ndarray:
-        """Net spring force (N, complex) on each of ``names`` at complex positions ``where`` (m).
-
-        ``resolved``: the model's resolved springs, whose first ``len(front)`` are ``front`` resolved (the
-        springs that mostly grow at their end) and the rest a few made anew each time."""
+    def prepare(self, front: Sequence[Spring], resolved: Sequence[Resolved], *, default_length: float) -> None:
+        """``resolved``: the model's resolved springs, whose first ``len(front)`` are ``front`` resolved (the
+        springs that mostly grow at their end) and the rest a few made anew each time; ``default_length``:
+        ``l`` (m) of an angle spring with no distance spring between its pivot and the place it turns."""
         fixed = self._fold(front)
-        tail = _Structure(slot=fixed.slot, count=len(front))  # the tail's own arrays; slots shared
+        tail = _Structure(slot=dict(fixed.slot), count=len(front))  # the tail's own arrays and slots
         tail.take(resolved[len(front):])
-        n = len(fixed.slot)
         kind = np.concatenate([np.frombuffer(fixed.kind, dtype=np.int8), np.frombuffer(tail.kind, dtype=np.int8)])
-        slots = np.concatenate([np.frombuffer(fixed.slots, dtype=np.int64),
-                                np.frombuffer(tail.slots, dtype=np.int64)]).reshape(-1, 3)
+        rows = np.concatenate([np.frombuffer(fixed.slots, dtype=np.int64),
+                               np.frombuffer(tail.slots, dtype=np.int64)]).reshape(-1, 3)
         stiffness = np.concatenate([np.frombuffer(fixed.stiffness), np.frombuffer(tail.stiffness)])
         value = np.array([s.value for s in resolved], dtype=float)
         length = np.zeros(len(resolved))
@@ -249,6 +254,28 @@ class SpringField:
                 length[i] = value[between[0]]
             else:
                 length[i] = min((resolved[j] for j in between), key=lambda s: (-s.stiffness, s.fields)).value
-        z = np.array([where[name] for name in fixed.slot], dtype=complex)
-        total = np.append(spring_forces(n, kind, slots, value, stiffness, length, z, core=core, share=share), 0j)
-        return total[np.array([fixed.slot.get(name, n) for name in names], dtype=int)]
+        self._parts = fixed, tail
+        self._slot, self._names = tail.slot, list(tail.slot)
+        self._arrays = kind, rows, value, stiffness, length
+
+    def around(self, names: Sequence[str], *, expand: Sequence[bool], centre: complex | None, expansion: float,
+               law: str, core: float, share: float) -> NetForce:
+        """The net force on ``names`` from every spring touching them (and the expansion force)."""
+        kind, rows, value, stiffness, length = self._arrays
+        fixed, tail = self._parts
+        slots = [self._slot[n] for n in names if n in self._slot]
+        mine = [i for part in (fixed, tail) for k in slots for i in part.incident.get(k, ())]
+        chosen = np.unique(np.array(mine, dtype=int))
+        sub = rows[chosen]
+        local = {name: i for i, name in enumerate(names)}
+        lookup = np.full(len(self._names) + 1, -1, dtype=int)
+        for name, i in local.items():
+            if name in self._slot:
+                lookup[self._slot[name]] = i
+        used = np.unique(sub)
+        others = used[lookup[used] < 0]
+        lookup[others] = len(local) + np.arange(len(others))
+        slots = list(names) + [self._names[i] for i in others.tolist()]
+        return NetForce.of_arrays(names, slots, kind[chosen], lookup[sub], value[chosen], stiffness[chosen],
+                                  length[chosen], expand=expand, centre=centre, expansion=expansion, law=law,
+                                  core=core, share=share)
