@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -24,3 +26,20 @@ def angle_at(vertex: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
 def settle(model: AbstractMap) -> None:
     report = model.settle()
     assert report.settled, f"did not settle in {report.iterations} steps"
+
+
+def walked(n_cues: int, places: int = 200, *, settled: bool = True) -> tuple[AbstractMap, object]:
+    """A model after the first ``n_cues`` cues of a small generated campus walk (``benchmarks/campus.py``),
+    settling after each (and asserting each settled, if ``settled``); and the walk."""
+    sys.path.append(str(Path(__file__).resolve().parents[2] / "benchmarks"))
+    import campus
+
+    walk = campus.generate(places)
+    model = AbstractMap.from_hierarchy(Hierarchy.from_nested(walk.tree), walk.start)
+    model.set_explored_centre(np.array(walk.start[:2]))
+    model.settle()
+    for tag, text, pose in walk.cues[:n_cues]:
+        model.observe_tag(tag, text, pose)
+        report = model.settle()
+        assert report.settled or not settled
+    return model, walk

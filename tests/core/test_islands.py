@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,25 +10,11 @@ import pytest
 from abstract_map.dynamics import SpringIndex
 from abstract_map.dynamics import settle as integrate
 from abstract_map.forces import forces_on
-from abstract_map.hierarchy import Hierarchy
 from abstract_map.model import AbstractMap
 from abstract_map.params import DynamicsParams
 from abstract_map.placement import Resolved
 
-sys.path.append(str(Path(__file__).resolve().parents[2] / "benchmarks"))
-import campus  # noqa: E402
-
-
-def walked(n_cues: int, places: int = 200) -> tuple[AbstractMap, campus.Campus]:
-    """A model after the first ``n_cues`` cues of a small generated campus walk, settling after each."""
-    walk = campus.generate(places)
-    model = AbstractMap.from_hierarchy(Hierarchy.from_nested(walk.tree), walk.start)
-    model.set_explored_centre(np.array(walk.start[:2]))
-    model.settle()
-    for tag, text, pose in walk.cues[:n_cues]:
-        model.observe_tag(tag, text, pose)
-        assert model.settle().settled
-    return model, walk
+from .helpers import walked
 
 
 def net_forces(model: AbstractMap) -> dict[str, float]:

@@ -19,6 +19,8 @@ from abstract_map.scales import learn_scales, natural_lengths
 from abstract_map.springs import Spring, springs_from_clauses
 from abstract_map.values import GrowingFold, RememberedHash
 
+from .helpers import walked
+
 sys.path.append(str(Path(__file__).resolve().parents[2] / "benchmarks"))
 import campus  # noqa: E402
 
@@ -80,12 +82,7 @@ def test_springs_keep_the_hash_they_were_made_with():
 
 
 def test_a_pickled_model_goes_on_settling_exactly_as_the_original():
-    walk = campus.generate(150)
-    model = AbstractMap.from_hierarchy(Hierarchy.from_nested(walk.tree), walk.start)
-    model.settle()
-    for tag, text, pose in walk.cues[:10]:
-        model.observe_tag(tag, text, pose)
-        model.settle()
+    model, walk = walked(10, 150, settled=False)
     copy = pickle.loads(pickle.dumps(model))
     for tag, text, pose in walk.cues[10:20]:
         for m in (model, copy):
@@ -96,12 +93,7 @@ def test_a_pickled_model_goes_on_settling_exactly_as_the_original():
 
 
 def test_the_spring_field_gives_each_mass_the_net_force_its_own_springs_give():
-    walk = campus.generate(150)
-    model = AbstractMap.from_hierarchy(Hierarchy.from_nested(walk.tree), walk.start)
-    model.settle()
-    for tag, text, pose in walk.cues[:25]:
-        model.observe_tag(tag, text, pose)
-        model.settle()
+    model, _ = walked(25, 150, settled=False)
     rng = np.random.default_rng(3)
     for name in model.positions:  # away from rest, so that every spring pulls
         model.positions[name] = model.positions[name] + rng.normal(0.0, 2.0, 2)
