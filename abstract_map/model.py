@@ -421,17 +421,7 @@ class AbstractMap:
         return self._resolver(front, self._cached("springs", self._springs)[len(front):],
                               self.hierarchy.levels(), self.hierarchy.version,
                               self._cached("observed", self._observed_positions), self.params.scales,
-                              self.exploration_factor, self.params.scale_band)
-
-    @property
-    def applied_scales(self) -> dict[ScaleKey, float]:
-        """The learned scale factors the last settle applied (within ``params.scale_band`` of equation 7's)."""
-        return dict(self._resolver.applied)
-
-    def apply_scales(self, factors: Mapping[ScaleKey, float]) -> None:
-        """Take ``factors`` as the learned scale factors last applied (a saved model's, on loading)."""
-        self._resolver.applied = dict(factors)
-        self._changed()
+                              self.exploration_factor)
 
     def position(self, place: str) -> np.ndarray:
         """Imagined position (m, world) of a place."""
@@ -536,7 +526,6 @@ class AbstractMap:
         max_steps, max_s = settle_caps(max_steps, max_s)
         began = time.perf_counter()
         springs = self.resolved_springs()
-        self._resolver.commit()
         places = self.places()
         new = [p for p in places if p not in self.positions]
         known = {**{n: f.xy for n, f in self.fixed.items()}, **self.positions}

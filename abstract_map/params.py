@@ -155,17 +155,10 @@ class AbstractMapParams:
     # a group at 0.1 m/s for as long as a settle runs: ~50 m per settle, without limit. With it the group's
     # drift is bounded: it rests one label scale (2 m for a leaf) ahead of the start until a cue ties it in.
     loose_stiffness: str = "S"
-    # A learned scale factor (equation 7) is applied anew only when its value leaves this band (a share of the
-    # factor applied) around the one applied, so natural lengths stay within 0.2 % of equation 7's (10 cm at
-    # 50 m, half the masses' minimum separation). Late in a walk a factor moves by about 0.1 % a label read,
-    # up and down as rooms lie nearer or farther than a sign's unit (generated campuses, development seed
-    # 0), and each move changed the length of every spring of its key: thousands at 5,000 places. 0: exact
-    scale_band: float = 0.002
 
     def __post_init__(self) -> None:
         _choice("AbstractMapParams.start_stiffness", self.start_stiffness, tuple(STIFFNESS))
         _choice("AbstractMapParams.loose_stiffness", self.loose_stiffness, tuple(STIFFNESS))
-        _positive("AbstractMapParams.scale_band", self.scale_band, allow_zero=True, high=0.1)
         if not isinstance(self.between_angle, bool):
             raise ValueError(f"AbstractMapParams.between_angle must be true or false, got {self.between_angle!r}")
 

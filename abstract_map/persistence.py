@@ -32,10 +32,8 @@ log = logging.getLogger(__name__)
 
 FORMAT = "abstract-map/1"
 _KEYS = ("format", "params", "hierarchy", "start", "start_roots", "goal", "fixed", "cue_clauses",
-         "loose_clauses", "positions", "velocities", "exploration_factor", "explored_centre", "settled_moving",
-         "scales_applied")
-# "settled_moving": null, or the places left moving when the model is saved just as its last settle left it;
-# "scales_applied": [[key, factor], ...], the learned scale factors the last settle applied (AbstractMap.applied_scales)
+         "loose_clauses", "positions", "velocities", "exploration_factor", "explored_centre", "settled_moving")
+# "settled_moving": null, or the places left moving when the model is saved just as its last settle left it
 _FIXED_KEYS = ("kind", "x", "y", "theta", "sightings", "text")
 # dynamics parameters older files lack (they load with the defaults)
 _NEW_DYNAMICS = ("angle_length", "angle_core_share", "wake_acceleration", "solver_iterations")
@@ -85,7 +83,7 @@ def _table(where: str, data: Any) -> dict[int, float]:
 def params_from_dict(data: Any, *, where: str = "params") -> AbstractMapParams:
     """Inverse of :func:`params_to_dict`; every value checked."""
     names = tuple(f.name for f in fields(AbstractMapParams))
-    data = _object(where, data, names, optional=("loose_stiffness", "scale_band"))
+    data = _object(where, data, names, optional=("loose_stiffness",))
     scales = _object(f"{where} scales", data["scales"], ("place", "sign", "label"))
     place = {}
     for key, value in _object(f"{where} scales place", scales["place"]).items():
@@ -134,7 +132,6 @@ def to_dict(model: AbstractMap) -> dict[str, Any]:
         "exploration_factor": model.exploration_factor,
         "explored_centre": None if model.explored_centre is None else [float(v) for v in model.explored_centre],
         "settled_moving": model.as_last_settled(),
-        "scales_applied": [[list(key), factor] for key, factor in model.applied_scales.items()],
     }
 
 
@@ -191,8 +188,7 @@ def from_dict(data: Any, *, where: str = "model") -> AbstractMap:
     data = _object(where, data)
     if data.get("format") != FORMAT:
         raise ModelFileError(f"{where}: format {errors.show(data.get('format'))}, expected {FORMAT!r}")
-    # files from before island settles lack settled_moving, and from before scale bands scales_applied
-    data = _object(where, data, _KEYS, optional=("settled_moving", "scales_applied"))
+    data = _object(where, data, _KEYS, optional=("settled_moving",))  # files from before island settles lack it
     params = params_from_dict(data["params"], where=f"{where} params")
     spec = _object(f"{where} hierarchy", data["hierarchy"], ("places", "parent"))
     try:
@@ -253,7 +249,6 @@ def from_dict(data: Any, *, where: str = "model") -> AbstractMap:
             model.set_goal(goal)
             if model.goal != goal:
                 raise ModelFileError(f"{where} goal: {errors.show(goal)} is not a place's spelling")
-        model.apply_scales(_scales_applied(f"{where} scales_applied", data.get("scales_applied", [])))
         model.springs()
         model.levels()
         moving = data.get("settled_moving")
@@ -270,21 +265,6 @@ def from_dict(data: Any, *, where: str = "model") -> AbstractMap:
     except (AbstractMapError, ValueError) as exc:
         raise ModelFileError(f"{where}: {exc}") from None
     return model
-
-
-def _scales_applied(where: str, data: Any) -> dict[tuple, float]:
-    """``[[key, factor], ...]``: a key ``["place", a, b]`` (levels a <= b) or ``["sign" | "label" | "start",
-    level]``, a factor (m per unit) in (0, 1e6]."""
-    out: dict[tuple, float] = {}
-    for item in _list(where, data):
-        key, factor = _list(where, item, 2)
-        key = _list(f"{where} key", key)
-        kinds = {"place": 3, "sign": 2, "label": 2, "start": 2}
-        if not key or key[0] not in kinds or len(key) != kinds[key[0]]:
-            raise ModelFileError(f"{where}: key {errors.show(key)} is not ['place', a, b] or [kind, level]")
-        levels = tuple(errors.integer(f"{where} key level", v, low=1, high=100, error=ModelFileError) for v in key[1:])
-        out[(key[0], *levels)] = errors.number(f"{where} {key}", factor, low=1e-9, high=1e6, error=ModelFileError)
-    return out
 
 
 def save(model: AbstractMap, path: str | os.PathLike[str]) -> None:

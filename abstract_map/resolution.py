@@ -127,8 +127,6 @@ class Resolver:
         self._table: _Table | None = None
         self._values = np.zeros(0)
         self._out: list[Resolved] = []
-        self.applied: dict[ScaleKey, float] = {}  # the learned scale factors the last settle used (saved)
-        self._pending: dict[ScaleKey, float] = {}
 
     def _new_fold(self) -> GrowingFold[Spring, _Table]:
         return GrowingFold[Spring, _Table](_Table, self._take)
@@ -152,10 +150,10 @@ class Resolver:
 
     def __call__(self, springs: Sequence[Spring], tail: Sequence[Spring], levels: Mapping[str, int],
                  levels_version: Hashable, observed: Mapping[str, np.ndarray], defaults: ScaleDefaults,
-                 exploration: float, band: float = 0.0) -> list[Resolved]:
+                 exploration: float) -> list[Resolved]:
         """The resolved ``springs`` (which mostly grow at their end from call to call), then ``tail`` (a few,
         made anew each call). ``observed``: observed positions (m) of places and fixed points;
-        ``levels_version`` changes whenever ``levels`` does; ``band``: see :meth:`_banded`."""
+        ``levels_version`` changes whenever ``levels`` does."""
         if levels_version != self._levels_version:
             self._levels_version, self._fold = levels_version, self._new_fold()
         self._levels = levels
@@ -163,7 +161,7 @@ class Resolver:
         seen = sorted({i for name in observed if not is_anchor(name) for i in table.learnable.get(name, ())})
         learnable = [table.springs[i] for i in seen] + \
             [s for s in tail if s.kind == "distance" and s.scale in LEARNABLE]
-        learned = self._banded(learn_scales(learnable, levels, observed.get), band)
+        learned = learn_scales(learnable, levels, observed.get)
         tail_keys = [table.keys.setdefault(scale_key(s, levels), len(table.keys)) if s.kind == "distance" else -1
                      for s in tail]
         alpha = np.array([learned.get(k, default_scale(k, defaults)) for k in table.keys] + [1.0])
@@ -178,21 +176,6 @@ class Resolver:
         ends = self._values_of(np.array(tail_keys, dtype=np.int64), np.array([s.value for s in tail], dtype=float),
                                np.array([s.scale == "label" for s in tail], dtype=np.int8), alpha, exploration)
         return out + [_resolved(s, float(v)) for s, v in zip(tail, ends.tolist())]
-
-    def _banded(self, learned: dict[ScaleKey, float], band: float) -> dict[ScaleKey, float]:
-        """The learned factors to apply: each key's :attr:`applied` factor while equation 7's value stays
-        within ``band`` (a share) of it, else the new value. They become the ones applied at :meth:`commit`
-        (a settle), so that reading a model never changes what it will do."""
-        banded = {}
-        for key, value in learned.items():
-            kept = self.applied.get(key)
-            banded[key] = value if kept is None or abs(value - kept) > band * kept else kept
-        self._pending = banded
-        return banded
-
-    def commit(self) -> None:
-        """Take the factors of the last call as the ones applied (a settle used them)."""
-        self.applied = dict(self._pending)
 
     @staticmethod
     def _values_of(key: np.ndarray, unit: np.ndarray, label: np.ndarray, alpha: np.ndarray,
