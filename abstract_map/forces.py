@@ -133,8 +133,9 @@ class NetForce:
     def of_arrays(cls, names: Sequence[str], slots: Sequence[str], kind: np.ndarray, rows: np.ndarray,
                   value: np.ndarray, stiffness: np.ndarray, length: np.ndarray, *, expand: Sequence[bool],
                   centre: complex | None, expansion: float, law: str, core: float, share: float) -> NetForce:
-        """The same from arrays (as :func:`spring_forces` takes them), ``rows`` indexing ``slots``, whose
-        first entries are ``names``."""
+        """The same from arrays, one row a spring: ``kind`` 0 distance (``value`` its natural length, m), 1
+        global and 2 relative angle (``value`` rad, ``length`` l, m); ``rows`` of 3 indexing ``slots`` (distance
+        and global springs use the first 2), whose first entries are ``names``."""
         net = cls.__new__(cls)
         net._build(names, slots, kind, rows, value, stiffness, length, expand=expand, centre=centre,
                    expansion=expansion, law=law, core=core, share=share)
@@ -172,23 +173,6 @@ class NetForce:
             ok = self.expand & (r > 1e-12)
             total[ok] += law(c, r[ok]) * mine[ok] / r[ok]
         return total
-
-
-def spring_forces(n: int, kind: np.ndarray, slots: np.ndarray, value: np.ndarray, stiffness: np.ndarray,
-                  length: np.ndarray, z: np.ndarray, *, core: float, share: float) -> np.ndarray:
-    """Net force (N, complex) of springs given as arrays on each of ``n`` slots at complex positions ``z`` (m):
-    ``kind`` 0 distance (``value`` its natural length, m), 1 global and 2 relative angle (``value`` rad,
-    ``length`` l, m); ``slots`` rows of 3 (distance and global springs use the first 2)."""
-    total = AngleSprings.of_arrays(n, kind, slots, value, stiffness, length, core=core, share=share)(z)
-    distance = np.flatnonzero(kind == 0)
-    if len(distance):
-        a, b = slots[distance, 0], slots[distance, 1]
-        d = z[b] - z[a]
-        r = np.abs(d)
-        f = stiffness[distance] * (r - value[distance]) * d / np.maximum(r, 1e-12)  # pulls a towards b
-        total += np.bincount(a, f.real, n) + 1j * np.bincount(a, f.imag, n)
-        total -= np.bincount(b, f.real, n) + 1j * np.bincount(b, f.imag, n)
-    return total
 
 
 def forces_on(names: Sequence[str], springs: Sequence[Resolved], where: Mapping[str, complex],

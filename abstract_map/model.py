@@ -543,7 +543,7 @@ class AbstractMap:
         fixed = {n: f.xy for n, f in self.fixed.items()}
         active, tested = self._disturbed(springs, new, fixed)
         self._field.prepare(self._cached("clause springs", self._springs_of_clauses), springs,
-                            default_length=self.params.dynamics.angle_length)
+                            partial(self._index.length, default=self.params.dynamics.angle_length))
         result = run_dynamics(self.positions, self.velocities, fixed, self._index, active=active, tested=tested,
                               field=self._field, expand=expand, centre=self.explored_centre,
                               params=self.params.dynamics, max_steps=max_steps,

@@ -18,7 +18,7 @@ Each gives exactly what its from-scratch counterpart (``springs_from_clauses``,
 from __future__ import annotations
 
 from array import array
-from collections.abc import Hashable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -30,7 +30,7 @@ from .forces import ANGLE_KINDS, NetForce
 from .params import ScaleDefaults
 from .placement import Resolved
 from .scales import LEARNABLE, ScaleKey, default_scale, learn_scales, scale_key
-from .springs import AnchorKind, Spring, clause_springs
+from .springs import AnchorKind, Spring, add_clause_springs
 from .values import GrowingFold
 
 
@@ -44,11 +44,7 @@ class ClauseSprings:
         self.flags: dict[str, bool] = {}
 
     def _take(self, unique: dict[Spring, None], clauses: Sequence[Clause]) -> None:
-        for clause in clauses:
-            made = self._made.get(clause)
-            if made is None:
-                made = self._made[clause] = clause_springs(clause, self.anchor_kind, self.flags)
-            unique.update(dict.fromkeys(made))
+        add_clause_springs(unique, clauses, self.anchor_kind, self.flags, memo=self._made)
 
     def __call__(self, clauses: Sequence[Clause], anchor_kind: AnchorKind, flags: dict[str, bool]) -> list[Spring]:
         """``anchor_kind`` and ``flags`` must be the same at every call (a fixed point's kind never changes)."""
@@ -199,8 +195,6 @@ class _Structure:
     kind: array = field(default_factory=lambda: array("b"))  # 0 distance, 1 global, 2 relative angle
     slots: array = field(default_factory=lambda: array("q"))  # 3 per spring (distance and global use 2)
     stiffness: array = field(default_factory=lambda: array("d"))
-    pairs: dict[frozenset[str], list[int]] = field(default_factory=dict)  # distance springs between two masses
-    angles: list[tuple[int, frozenset[str]]] = field(default_factory=list)  # angle spring, (pivot, place turned)
     incident: dict[int, list[int]] = field(default_factory=dict)  # slot -> the springs touching it
     count: int = 0
 
@@ -212,11 +206,6 @@ class _Structure:
                 self.incident.setdefault(end, []).append(self.count)
             self.kind.append(ANGLE_KINDS.get(s.kind, 0))
             self.stiffness.append(s.stiffness)
-            pair = frozenset(s.ends[-2:])
-            if s.kind == "distance":
-                self.pairs.setdefault(pair, []).append(self.count)
-            else:
-                self.angles.append((self.count, pair))
             self.count += 1
 
 
@@ -233,10 +222,11 @@ class SpringField:
         self._parts: tuple[_Structure, _Structure] = (_Structure(), _Structure())
         self._arrays: tuple[np.ndarray, ...] = ()
 
-    def prepare(self, front: Sequence[Spring], resolved: Sequence[Resolved], *, default_length: float) -> None:
+    def prepare(self, front: Sequence[Spring], resolved: Sequence[Resolved],
+                length: Callable[[Resolved], float]) -> None:
         """``resolved``: the model's resolved springs, whose first ``len(front)`` are ``front`` resolved (the
-        springs that mostly grow at their end) and the rest a few made anew each time; ``default_length``:
-        ``l`` (m) of an angle spring with no distance spring between its pivot and the place it turns."""
+        springs that mostly grow at their end) and the rest a few made anew each time; ``length``: an angle
+        spring's ``l`` (m), as ``dynamics.SpringIndex.length`` gives it."""
         fixed = self._fold(front)
         tail = _Structure(slot=dict(fixed.slot), count=len(front))  # the tail's own arrays and slots
         tail.take(resolved[len(front):])
@@ -245,18 +235,12 @@ class SpringField:
                                np.frombuffer(tail.slots, dtype=np.int64)]).reshape(-1, 3)
         stiffness = np.concatenate([np.frombuffer(fixed.stiffness), np.frombuffer(tail.stiffness)])
         value = np.array([s.value for s in resolved], dtype=float)
-        length = np.zeros(len(resolved))
-        for i, pair in fixed.angles + tail.angles:  # l: the stiffest distance spring's length (ties: field order)
-            between = fixed.pairs.get(pair, []) + tail.pairs.get(pair, [])
-            if not between:
-                length[i] = default_length
-            elif len(between) == 1:
-                length[i] = value[between[0]]
-            else:
-                length[i] = min((resolved[j] for j in between), key=lambda s: (-s.stiffness, s.fields)).value
+        lengths = np.zeros(len(resolved))
+        for i in np.flatnonzero(kind).tolist():
+            lengths[i] = length(resolved[i])
         self._parts = fixed, tail
         self._slot, self._names = tail.slot, list(tail.slot)
-        self._arrays = kind, rows, value, stiffness, length
+        self._arrays = kind, rows, value, stiffness, lengths
 
     def around(self, names: Sequence[str], *, expand: Sequence[bool], centre: complex | None, expansion: float,
                law: str, core: float, share: float) -> NetForce:

@@ -124,11 +124,11 @@ def clause_springs(clause: Clause, anchor_kind: AnchorKind, flags: dict[str, boo
     return _locational_springs(clause, anchor_kind)
 
 
-def springs_from_clauses(clauses: Iterable[Clause], anchor_kind: AnchorKind, flags: dict[str, bool] | None = None,
-                         *, memo: dict[Clause, list[Spring]] | None = None) -> list[Spring]:
-    """All springs of the clauses, each spring once, in first-seen order. ``memo``, if given, keeps each
-    clause's springs from one call to the next (valid while ``anchor_kind`` and ``flags`` stay the same)."""
-    unique: dict[Spring, None] = {}
+def add_clause_springs(unique: dict[Spring, None], clauses: Iterable[Clause], anchor_kind: AnchorKind,
+                       flags: dict[str, bool] | None = None, *, memo: dict[Clause, list[Spring]] | None = None) -> None:
+    """Add the springs of ``clauses`` to ``unique``, each spring once, in first-seen order. ``memo``, if given,
+    keeps each clause's springs from one call to the next (valid while ``anchor_kind`` and ``flags`` stay the
+    same)."""
     for clause in clauses:
         made = None if memo is None else memo.get(clause)
         if made is None:
@@ -136,4 +136,11 @@ def springs_from_clauses(clauses: Iterable[Clause], anchor_kind: AnchorKind, fla
             if memo is not None:
                 memo[clause] = made
         unique.update(dict.fromkeys(made))
+
+
+def springs_from_clauses(clauses: Iterable[Clause], anchor_kind: AnchorKind,
+                         flags: dict[str, bool] | None = None) -> list[Spring]:
+    """All springs of the clauses, each spring once, in first-seen order."""
+    unique: dict[Spring, None] = {}
+    add_clause_springs(unique, clauses, anchor_kind, flags)
     return list(unique)

@@ -108,7 +108,7 @@ def test_the_spring_field_gives_each_mass_the_net_force_its_own_springs_give():
                          core=params.angle_core, share=params.angle_core_share)
     field = SpringField()
     field.prepare(model._cached("clause springs", model._springs_of_clauses), springs,
-                  default_length=params.angle_length)
+                  lambda s: index.length(s, params.angle_length))
     net = field.around(names, expand=[False] * len(names), centre=None, expansion=0.0, law="constant",
                        core=params.angle_core, share=params.angle_core_share)
     got = net(np.array([where[n] for n in net.slots], dtype=complex))
