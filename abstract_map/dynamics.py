@@ -100,7 +100,10 @@ class SpringIndex:
         and the place it turns (global: reference and figure; relative: vertex and its second place)."""
         pivot, turned = spring.ends[-2:]
         if (pivot, turned) not in self._lengths:
-            between = [s for s in self.touching.get(pivot, {}) if s.kind == "distance" and turned in s.ends]
+            # the springs between them touch both: look through the fewer (a sign touches hundreds)
+            a, b = self.touching.get(pivot, {}), self.touching.get(turned, {})
+            other = turned if len(a) <= len(b) else pivot
+            between = [s for s in (a if len(a) <= len(b) else b) if s.kind == "distance" and other in s.ends]
             # the stiffest; of equals, the first in field order (not the order the index met them in)
             best = min(between, key=lambda s: (-s.stiffness, s.fields), default=None)
             self._lengths[pivot, turned] = None if best is None else best.value

@@ -92,8 +92,10 @@ class _LastSettle:
     moving: list[str]  # places left with |v| >= L_v (by a cap)
 
     @classmethod
-    def of(cls, springs: list[Resolved], fixed: dict[str, np.ndarray], moving: list[str]) -> _LastSettle:
-        current = set(springs)
+    def of(cls, springs: list[Resolved], fixed: dict[str, np.ndarray], moving: list[str],
+           current: set[Resolved] | None = None) -> _LastSettle:
+        """``current``: ``set(springs)`` when already at hand."""
+        current = set(springs) if current is None else current
         duplicates = len(springs) - len(current)
         return cls(current, Counter(springs) if duplicates else Counter(), duplicates, fixed, moving)
 
@@ -465,14 +467,13 @@ class AbstractMap:
             return
         self.explored_centre = np.array(errors.point("explored centre", xy, error=ModelError))
 
-    def _disturbed(self, springs: list[Resolved], new: list[str],
+    def _disturbed(self, springs: list[Resolved], current: set[Resolved], new: list[str],
                    fixed: Mapping[str, np.ndarray]) -> tuple[list[str], list[str]]:
         """Bring the spring index up to date; the places a settle starts from, and those it tests first.
 
         The first settle moves every place. After it: the new places and those a capped settle left moving
         (|v| >= L_v) move; the ends of springs added, removed or changed, and of springs to fixed points that
         moved, since the last settle are tested, and move if they fail Algorithm 1's acceleration test."""
-        current = set(springs)
         last = self._last_settle
         if last is None or len(springs) - len(current) or last.duplicates:  # a spring twice: count them all
             self._index = SpringIndex(springs)
@@ -528,12 +529,14 @@ class AbstractMap:
         springs = self.resolved_springs()
         places = self.places()
         new = [p for p in places if p not in self.positions]
-        known = {**{n: f.xy for n, f in self.fixed.items()}, **self.positions}
-        origin = np.array(self.start[:2])
-        new_set = set(new)
-        near = [s for s in springs if not new_set.isdisjoint(s.ends)] if new else []  # Algorithm 2 needs no other
-        placed = place_new_masses(new, known, near, origin=origin, heading=self.start[2],
-                                  min_separation=self.params.dynamics.min_separation)
+        placed: dict[str, np.ndarray] = {}
+        if new:  # Algorithm 2 needs only the springs touching a new mass
+            known = {**{n: f.xy for n, f in self.fixed.items()}, **self.positions}
+            origin = np.array(self.start[:2])
+            new_set = set(new)
+            near = [s for s in springs if not new_set.isdisjoint(s.ends)]
+            placed = place_new_masses(new, known, near, origin=origin, heading=self.start[2],
+                                      min_separation=self.params.dynamics.min_separation)
         for name, xy in placed.items():
             self.positions[name] = xy
             self.velocities[name] = np.zeros(2)
@@ -541,7 +544,8 @@ class AbstractMap:
         expand = set(places) if self.params.dynamics.expansion_on == "all" else \
             {p for p in places if p not in parents}
         fixed = {n: f.xy for n, f in self.fixed.items()}
-        active, tested = self._disturbed(springs, new, fixed)
+        current = set(springs)
+        active, tested = self._disturbed(springs, current, new, fixed)
         self._field.prepare(self._cached("clause springs", self._springs_of_clauses), springs,
                             partial(self._index.length, default=self.params.dynamics.angle_length))
         result = run_dynamics(self.positions, self.velocities, fixed, self._index, active=active, tested=tested,
@@ -560,7 +564,7 @@ class AbstractMap:
         self.velocities.update(result.velocities)
         limit = self.params.dynamics.settle_velocity
         self._last_settle = _LastSettle.of(springs, fixed, [n for n, v in result.velocities.items()
-                                                            if float(np.hypot(*v)) >= limit])
+                                                            if float(np.hypot(*v)) >= limit], current)
         return SettleReport(result.settled, result.iterations, time.perf_counter() - began, tuple(new),
                             result.stopped_by, len(result.positions))
 
