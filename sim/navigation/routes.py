@@ -2,22 +2,23 @@
 
 A sign's arrow points along the first leg of the shortest route from the sign
 to what it names (the convention of ``worlds/README.md``, which ``world check``
-tests to within 45 degrees). So a cell ``x`` is consistent with the arrow when
-setting off along it costs no detour: with ``s`` the spot in front of the sign,
-``p`` a probe ``lead_m`` along the arrow, and ``D_s``, ``D_p`` path lengths
-over the robot's map (mapped walls block, unseen space is open),
+tests to within 45 degrees, the reader standing 1 m in front of the sign). So
+a cell ``x`` is consistent with the arrow when its shortest route from the
+reader's spot ``s`` sets off along the arrow: with ``q(x)`` the point where
+that route (over the robot's map: mapped walls block, unseen space is open)
+first leaves the circle of radius ``lead_m`` about ``s``,
 
-    detour(x) = lead + D_p(x) - D_s(x)    (>= 0 by the triangle inequality)
+    error(x) = | angle(q(x) - s) - arrow |    (the first leg's direction against the arrow)
 
-is near 0 where the route sets off along the arrow and near ``2 lead`` behind
-it. The likelihood of the arrow given the place at ``x`` is
+and the likelihood of the arrow given the place at ``x`` is
 
-    L(x) = wrong + (1 - wrong) exp(-max(detour(x) - slack, 0) / scale)
+    L(x) = wrong + (1 - wrong) exp(-max(error(x) - tolerance, 0) / spread)
 
 with ``wrong`` the chance the arrow is wrong (misleading signs) or, for an
 arrow naming an area that holds the place, that the area's route is not the
-place's. Early on, with nothing mapped, ``L`` is a soft cone about the arrow;
-as walls are mapped it follows corridors round corners.
+place's. Early on, with nothing mapped, ``L`` is a cone about the arrow; as
+walls are mapped it follows corridors round corners, and an arrow pointing
+away from a place behind a wall says the way round lies that way.
 
 Labels hang beside doors on the side a door is approached from, so a room's
 inner walls carry only the labels of rooms reached through it. From the start
@@ -47,10 +48,12 @@ class RouteParams:
     """How arrows constrain where the goal can be."""
 
     cell_m: float = 0.3  # m, coarse cells for route lengths: a 1 m door stays open, a 0.2 m wall still blocks
-    stand_m: float = 0.6  # m in front of the sign where a reader stands
-    lead_m: float = 2.0  # m along the arrow where the route's first leg is probed
-    slack_m: float = 0.6  # m of detour forgiven: a first leg 45 degrees off the arrow costs lead (1 - cos 45)
-    scale_m: float = 1.0  # m of further detour that divides the likelihood by e
+    stand_m: float = 1.0  # m in front of the sign where a reader stands (the signage convention's reader)
+    lead_m: float = 1.5  # m from the reader where a route's first leg is read off (five route cells: its
+    # direction to within about 10 degrees on the 8-connected grid, and short of most corridors' first turn)
+    tolerance_deg: float = 45.0  # deg a first leg may lie off its arrow (the convention's, as `world check`)
+    spread_deg: float = 20.0  # deg beyond the tolerance that divide the likelihood by e: an 8-connected path
+    # may take its diagonal steps first, so a first leg read off the grid can lie up to 22.5 deg off its line
     wrong_prob: float = 0.1  # chance an arrow naming the goal is wrong ("misleading" signage: one in ten)
     area_wrong_prob: float = 0.35  # for an arrow naming an area holding the goal: the goal may lie off the
     # area's route (a wing's arrow leads to its nearest room, not to every room of it)
@@ -91,17 +94,30 @@ class PathSearches:
     that grid changed (walls are mapped slowly, so the coarse grids often stay the same for a while)."""
 
     costs: dict[str, np.ndarray] = field(default_factory=dict)  # the cost grid of each kind of search
-    found: dict[tuple[str, tuple[int, int]], np.ndarray] = field(default_factory=dict)  # (kind, start) -> lengths
+    found: dict[tuple[str, tuple[int, int]], tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+    # (kind, start) -> lengths and predecessors
 
     def lengths(self, kind: str, costs: np.ndarray, start: tuple[int, int]) -> np.ndarray:
         """Cumulative cost (in cells of ``costs``) from ``start`` to every cell of ``costs`` (inf: cut off), by
         scikit-image's minimum-cost path, 8-connected."""
+        return self.tree(kind, costs, start)[0]
+
+    def tree(self, kind: str, costs: np.ndarray, start: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`lengths`, and each cell's predecessor on its shortest path from ``start`` (flat index into
+        ``costs``; ``start`` and cells cut off are their own)."""
         known = self.costs.get(kind)
         if known is None or known.shape != costs.shape or not np.array_equal(known, costs):
             self.costs[kind] = costs.copy()
             self.found = {key: value for key, value in self.found.items() if key[0] != kind}
         if (kind, start) not in self.found:
-            self.found[kind, start] = MCP_Geometric(costs, fully_connected=True).find_costs([start])[0]
+            mcp = MCP_Geometric(costs, fully_connected=True)
+            lengths, traceback = mcp.find_costs([start])
+            offsets = np.asarray(mcp.offsets)
+            rows, cols = np.indices(costs.shape)
+            back = np.where(traceback >= 0, traceback, 0)
+            pred = (rows - offsets[back, 0]) * costs.shape[1] + (cols - offsets[back, 1])
+            pred = np.where((traceback >= 0) & np.isfinite(lengths), pred, np.arange(costs.size).reshape(costs.shape))
+            self.found[kind, start] = (lengths, pred.ravel())
         return self.found[kind, start]
 
 
@@ -130,22 +146,38 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
     costs = np.where(blocked, np.inf, 1.0)
     step = pool * grid.resolution
     total = np.ones(blocked.shape)
+    tolerance, spread = math.radians(params.tolerance_deg), math.radians(params.spread_deg)
     for arrow in arrows:
         sign = np.asarray(arrow.sign_xy, dtype=float)
-        stand = sign + params.stand_m * np.array([math.cos(arrow.facing), math.sin(arrow.facing)])
-        probe = stand + params.lead_m * np.array([math.cos(arrow.direction), math.sin(arrow.direction)])
-        s, p = _cell(grid, pool, blocked, stand), _cell(grid, pool, blocked, probe)
-        if s is None or p is None or s == p:
+        stand = _cell(grid, pool, blocked, sign + params.stand_m * np.array([math.cos(arrow.facing),
+                                                                            math.sin(arrow.facing)]))
+        if stand is None:
             continue
-        d_s = searches.lengths("route", costs, s) * step
-        d_p = searches.lengths("route", costs, p) * step
-        lead = float(np.hypot(p[0] - s[0], p[1] - s[1])) * step
-        with np.errstate(invalid="ignore"):
-            detour = np.where(np.isfinite(d_s) & np.isfinite(d_p), lead + d_p - d_s, 0.0)
-        near = np.exp(-np.maximum(detour - params.slack_m, 0.0) / params.scale_m)
+        lengths, pred = searches.tree("route", costs, stand)
+        leg = first_leg_points(lengths.ravel(), pred, params.lead_m / step)
+        rows, cols = np.divmod(leg, blocked.shape[1])
+        heading = np.arctan2(-(rows - stand[0]), cols - stand[1])  # rows run down the map: y is -row
+        error = np.abs(np.angle(np.exp(1j * (heading - arrow.direction))))
+        near = np.exp(-np.maximum(error - tolerance, 0.0) / spread).reshape(blocked.shape)
+        near[~np.isfinite(lengths)] = 1.0  # cut off from the reader: the arrow says nothing there
+        near[stand] = 1.0
         total *= arrow.wrong_prob + (1.0 - arrow.wrong_prob) * near
     fine = unpool_cells(total, pool, grid.shape)
     return fine / float(fine.max())
+
+
+def first_leg_points(lengths: np.ndarray, pred: np.ndarray, lead: float) -> np.ndarray:
+    """Per cell (flat), the cell where its shortest path from the search's start first leaves the ``lead``
+    (cells of path) around it: the first ancestor within ``lead`` (the cell itself when within). By pointer
+    jumping: each round doubles how far back a cell looks."""
+    inside = ~(lengths > lead)  # within the lead, or cut off (kept as itself)
+    jump = np.where(inside, np.arange(len(lengths)), pred)
+    for _ in range(64):
+        nxt = jump[jump]
+        if np.array_equal(nxt, jump):
+            return jump
+        jump = nxt
+    raise RuntimeError("first_leg_points: predecessors form a cycle")
 
 
 def door_depth_weight(grid: OccupancyGrid, start_xy: np.ndarray, params: RouteParams = RouteParams(),

@@ -40,6 +40,20 @@ def test_an_arrow_favours_what_lies_along_its_route_and_never_rules_out():
     assert route_likelihood(grid, []) is None
 
 
+def test_an_arrow_holds_its_first_leg_to_the_signage_conventions_45_degrees():
+    """Open floor: the route to a cell sets off straight at it from the reader, 1 m in front of the sign."""
+    grid = grid_of([])
+    east = Arrow(sign_xy=(10.0, 5.0), facing=math.pi / 2, direction=0.0, wrong_prob=0.1)
+    reader = np.array([10.0, 6.0])
+    likelihood = route_likelihood(grid, [east])
+    for degrees in (0.0, 20.0, 35.0, -35.0):
+        cell = reader + 5.0 * np.array([math.cos(math.radians(degrees)), math.sin(math.radians(degrees))])
+        assert at(grid, likelihood, *cell) == pytest.approx(1.0)
+    for degrees in (80.0, 120.0, 180.0, -100.0):  # off by more than the tolerance and the grid's zig-zag
+        cell = reader + 5.0 * np.array([math.cos(math.radians(degrees)), math.sin(math.radians(degrees))])
+        assert at(grid, likelihood, *cell) < 0.3
+
+
 def test_route_likelihood_follows_a_corridor_round_its_corner():
     """A wall north of the sign with a gap at its east end: an arrow east leads to the room north of the wall,
     while a straight-line cone would have called it off the route only by the angle."""
@@ -73,7 +87,7 @@ def test_kept_path_searches_give_the_same_evidence_and_run_again_only_on_a_chang
     start = np.array([2.0, 1.0])
     depth, route = door_depth_weight(grid, start, searches=searches), route_likelihood(grid, [east], searches=searches)
     found = dict(searches.found)
-    assert sorted(kind for kind, _ in found) == ["doors", "plain", "route", "route"]
+    assert sorted(kind for kind, _ in found) == ["doors", "plain", "route"]  # one search from the reader
     assert np.array_equal(depth, door_depth_weight(grid, start, searches=searches))
     assert np.array_equal(route, route_likelihood(grid, [east], searches=searches))
     assert all(searches.found[key] is found[key] for key in found)  # the same map: no search run again
@@ -83,3 +97,43 @@ def test_kept_path_searches_give_the_same_evidence_and_run_again_only_on_a_chang
     plain = next(key for key in found if key[0] == "plain")
     assert searches.found[plain] is not found[plain]  # run again on the changed map
     assert searches.found.keys() >= {key for key in found if key[0] == "route"}  # kept: only depth was asked
+
+
+def mapped(world) -> OccupancyGrid:
+    """A grid over ``world`` with every cell mapped as its floor plan has it."""
+    x0, x1, y0, y1 = world.floorplan.extent
+    grid = OccupancyGrid(OccupancyParams(resolution_m=0.1, bounds=(x0, x1, y0, y1)))
+    xy = grid.cell_to_world(np.argwhere(np.ones(grid.shape, dtype=bool)))
+    plan = world.floorplan
+    col = ((xy[:, 0] - plan.origin[0]) / plan.resolution).astype(int)
+    row = plan.shape[0] - 1 - ((xy[:, 1] - plan.origin[1]) / plan.resolution).astype(int)
+    inside = (row >= 0) & (row < plan.shape[0]) & (col >= 0) & (col < plan.shape[1])
+    occupied = np.zeros(len(xy), dtype=bool)
+    occupied[inside] = plan.occupied[row[inside], col[inside]]
+    cells = grid.world_to_cell(xy)
+    grid.log_odds[cells[:, 0], cells[:, 1]] = np.where(occupied, 3.0, -2.0)
+    return grid
+
+
+@pytest.mark.parametrize("style", ["office", "museum"])
+def test_on_a_mapped_building_every_true_arrow_favours_the_place_it_names(style):
+    """The generator writes each arrow within 40 degrees of its route's first leg: with the building mapped, the
+    arrow's likelihood in front of the named goal's label is high (development seed 0)."""
+    from abstract_map.prepositions import ARROWS
+    from sim.world.generator import generate
+
+    world = generate(0, style=style).world
+    grid = mapped(world)
+    checked = 0
+    for tag in world.tags.values():
+        for line in tag.text.split("\n") if tag.kind == "sign" else ():
+            word, _, names = line.partition(" ")
+            if word.strip("$") not in ARROWS or not word.startswith("$"):
+                continue
+            for name in (n for n in names.split(", ") if n in world.goals):
+                label = world.tags[world.goals[name]]
+                arrow = Arrow((tag.x, tag.y), tag.theta, tag.theta + ARROWS[word.strip("$")], 0.0)
+                front = (label.x + 1.5 * math.cos(label.theta), label.y + 1.5 * math.sin(label.theta))
+                assert at(grid, route_likelihood(grid, [arrow]), *front) > 0.4, (tag.id, word, name)
+                checked += 1
+    assert checked >= 5
