@@ -65,6 +65,7 @@ class SpringIndex:
     def __init__(self, springs: Sequence[Resolved] = ()) -> None:
         self.count: Counter[Resolved] = Counter()
         self.touching: dict[str, dict[Resolved, None]] = {}
+        self._between: dict[tuple[str, str], dict[Resolved, None]] = {}  # sorted ends -> distance springs
         self._lengths: dict[tuple[str, str], float | None] = {}  # (pivot, turned) -> l, or None: no distance spring
         self.update(springs, ())
 
@@ -76,17 +77,20 @@ class SpringIndex:
                 del self.count[s]
                 for end in s.ends:
                     self.touching[end].pop(s, None)
-                self._forget_length(s)
+                if s.kind == "distance":
+                    self._between[_pair(*s.ends)].pop(s, None)
+                    self._forget_length(s)
         for s in added:
             self.count[s] += 1
             for end in s.ends:
                 self.touching.setdefault(end, {})[s] = None
-            self._forget_length(s)
+            if s.kind == "distance":
+                self._between.setdefault(_pair(*s.ends), {})[s] = None
+                self._forget_length(s)
 
     def _forget_length(self, s: Resolved) -> None:
-        if s.kind == "distance":
-            self._lengths.pop((s.ends[0], s.ends[1]), None)
-            self._lengths.pop((s.ends[1], s.ends[0]), None)
+        self._lengths.pop((s.ends[0], s.ends[1]), None)
+        self._lengths.pop((s.ends[1], s.ends[0]), None)
 
     def around(self, names: Iterable[str]) -> list[Resolved]:
         """Every spring touching one of ``names``, once each."""
@@ -100,15 +104,17 @@ class SpringIndex:
         and the place it turns (global: reference and figure; relative: vertex and its second place)."""
         pivot, turned = spring.ends[-2:]
         if (pivot, turned) not in self._lengths:
-            # the springs between them touch both: look through the fewer (a sign touches hundreds)
-            a, b = self.touching.get(pivot, {}), self.touching.get(turned, {})
-            other = turned if len(a) <= len(b) else pivot
-            between = [s for s in (a if len(a) <= len(b) else b) if s.kind == "distance" and other in s.ends]
+            between = self._between.get(_pair(pivot, turned), {})
             # the stiffest; of equals, the first in field order (not the order the index met them in)
             best = min(between, key=lambda s: (-s.stiffness, s.fields), default=None)
             self._lengths[pivot, turned] = None if best is None else best.value
         length = self._lengths[pivot, turned]
         return default if length is None else length
+
+
+def _pair(a: str, b: str) -> tuple[str, str]:
+    """Two names in a fixed order: the key of the springs between them."""
+    return (a, b) if a <= b else (b, a)
 
 
 class ComplexPositions(dict):  # type: ignore[type-arg]

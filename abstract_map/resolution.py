@@ -20,8 +20,6 @@ from __future__ import annotations
 from array import array
 from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from itertools import compress
-from operator import is_not
 
 import numpy as np
 from scipy.sparse import coo_matrix
@@ -198,7 +196,6 @@ class _Structure:
     slots: array = field(default_factory=lambda: array("q"))  # 3 per spring (distance and global use 2)
     stiffness: array = field(default_factory=lambda: array("d"))
     incident: dict[int, list[int]] = field(default_factory=dict)  # slot -> the springs touching it
-    turns: dict[tuple[str, str], list[int]] = field(default_factory=dict)  # (pivot, turned) -> its angle springs
     count: int = 0
 
     def take(self, springs: Sequence[Spring | Resolved]) -> None:
@@ -207,8 +204,6 @@ class _Structure:
             self.slots.extend(ends + [0] * (3 - len(ends)))
             for end in ends:
                 self.incident.setdefault(end, []).append(self.count)
-            if s.kind in ANGLE_KINDS:
-                self.turns.setdefault((s.ends[-2], s.ends[-1]), []).append(self.count)
             self.kind.append(ANGLE_KINDS.get(s.kind, 0))
             self.stiffness.append(s.stiffness)
             self.count += 1
@@ -226,19 +221,12 @@ class SpringField:
         self._names: list[str] = []
         self._parts: tuple[_Structure, _Structure] = (_Structure(), _Structure())
         self._arrays: tuple[np.ndarray, ...] = ()
-        # The front's resolved springs at the last prepare, with their values and angle lengths (m), kept so
-        # that the next prepare redoes only the springs remade or added since.
-        self._front: tuple[_Structure | None, list[Resolved], np.ndarray, np.ndarray] = \
-            (None, [], np.zeros(0), np.zeros(0))
 
     def prepare(self, front: Sequence[Spring], resolved: Sequence[Resolved],
                 length: Callable[[Resolved], float]) -> None:
         """``resolved``: the model's resolved springs, whose first ``len(front)`` are ``front`` resolved (the
         springs that mostly grow at their end) and the rest a few made anew each time; ``length``: an angle
-        spring's ``l`` (m), as ``dynamics.SpringIndex.length`` gives it.
-
-        Of the front, only the springs resolved anew since the last call (a :class:`Resolver` keeps the
-        others' objects) and the angle springs whose ``l`` they may set are looked at again."""
+        spring's ``l`` (m), as ``dynamics.SpringIndex.length`` gives it."""
         fixed = self._fold(front)
         tail = _Structure(slot=dict(fixed.slot), count=len(front))  # the tail's own arrays and slots
         tail.take(resolved[len(front):])
@@ -246,41 +234,13 @@ class SpringField:
         rows = np.concatenate([np.frombuffer(fixed.slots, dtype=np.int64),
                                np.frombuffer(tail.slots, dtype=np.int64)]).reshape(-1, 3)
         stiffness = np.concatenate([np.frombuffer(fixed.stiffness), np.frombuffer(tail.stiffness)])
-        value_front, length_front = self._front_values(fixed, resolved[:len(front)], kind, length)
-        value = np.concatenate([value_front, [s.value for s in resolved[len(front):]]])
-        lengths = np.concatenate([length_front, np.zeros(len(resolved) - len(front))])
-        for i in (len(front) + np.flatnonzero(kind[len(front):])).tolist():
+        value = np.array([s.value for s in resolved], dtype=float)
+        lengths = np.zeros(len(resolved))
+        for i in np.flatnonzero(kind).tolist():
             lengths[i] = length(resolved[i])
         self._parts = fixed, tail
         self._slot, self._names = tail.slot, list(tail.slot)
         self._arrays = kind, rows, value, stiffness, lengths
-
-    def _front_values(self, fixed: _Structure, now: Sequence[Resolved], kind: np.ndarray,
-                      length: Callable[[Resolved], float]) -> tuple[np.ndarray, np.ndarray]:
-        """The front's natural values and angle lengths (m), redoing only what changed since the last call."""
-        was, before, value, lengths = self._front
-        n = len(now)
-        if was is not fixed or len(before) > n:  # the fold started again: every spring is new
-            before, value, lengths = [], np.zeros(0), np.zeros(0)
-        kept = len(before)
-        remade = list(compress(range(kept), map(is_not, before, now)))  # objects differ: resolved anew
-        value = np.concatenate([value, np.zeros(n - kept)])
-        lengths = np.concatenate([lengths, np.zeros(n - kept)])
-        redo = [*remade, *range(kept, n)]
-        value[redo] = [now[i].value for i in redo]
-        # an angle spring's l is the stiffest distance spring's between its pivot and turned place
-        turns: set[int] = set()
-        for i in redo:
-            s = now[i]
-            if kind[i]:
-                turns.add(i)
-            else:
-                turns.update(fixed.turns.get((s.ends[0], s.ends[1]), ()))
-                turns.update(fixed.turns.get((s.ends[1], s.ends[0]), ()))
-        for i in turns:
-            lengths[i] = length(now[i])
-        self._front = fixed, list(now), value, lengths
-        return value, lengths
 
     def around(self, names: Sequence[str], *, expand: Sequence[bool], centre: complex | None, expansion: float,
                law: str, core: float, share: float) -> NetForce:

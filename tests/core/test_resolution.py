@@ -120,20 +120,3 @@ def test_the_spring_field_gives_each_mass_the_net_force_its_own_springs_give():
     assert np.allclose(net(np.array([where[n] for n in net.slots], dtype=complex)), expected[::7], rtol=1e-9,
                        atol=1e-12)
 
-
-def test_the_spring_field_kept_cue_by_cue_holds_what_one_prepared_afresh_holds():
-    walk = campus.generate(150)
-    model = AbstractMap.from_hierarchy(Hierarchy.from_nested(walk.tree), walk.start)
-    params = model.params.dynamics
-    for i, (tag, text, pose) in enumerate(walk.cues[:40]):
-        model.observe_tag(tag, text, pose)
-        if i == 20:  # a level added: the field's fold starts again
-            model.add_clauses([Relational("in", "Campus", ("Campus annex",))])
-        if i == 30:  # every explored length changes
-            model.bump_exploration()
-        model.settle()
-        fresh = SpringField()
-        fresh.prepare(model._cached("clause springs", model._springs_of_clauses), model.resolved_springs(),
-                      lambda s: model._index.length(s, params.angle_length))
-        for kept, made in zip(model._field._arrays, fresh._arrays, strict=True):
-            assert np.array_equal(kept, made)
