@@ -66,7 +66,7 @@ class SpringIndex:
         self.count: Counter[Resolved] = Counter()
         self.touching: dict[str, dict[Resolved, None]] = {}
         self._between: dict[tuple[str, str], dict[Resolved, None]] = {}  # sorted ends -> distance springs
-        self._lengths: dict[tuple[str, str], float | None] = {}  # (pivot, turned) -> l, or None: no distance spring
+        self._lengths: dict[tuple[str, str], float | None] = {}  # sorted ends -> l, or None: no distance spring
         self.update(springs, ())
 
     def update(self, added: Iterable[Resolved], removed: Iterable[Resolved]) -> None:
@@ -79,18 +79,14 @@ class SpringIndex:
                     self.touching[end].pop(s, None)
                 if s.kind == "distance":
                     self._between[_pair(*s.ends)].pop(s, None)
-                    self._forget_length(s)
+                    self._lengths.pop(_pair(*s.ends), None)
         for s in added:
             self.count[s] += 1
             for end in s.ends:
                 self.touching.setdefault(end, {})[s] = None
             if s.kind == "distance":
                 self._between.setdefault(_pair(*s.ends), {})[s] = None
-                self._forget_length(s)
-
-    def _forget_length(self, s: Resolved) -> None:
-        self._lengths.pop((s.ends[0], s.ends[1]), None)
-        self._lengths.pop((s.ends[1], s.ends[0]), None)
+                self._lengths.pop(_pair(*s.ends), None)
 
     def around(self, names: Iterable[str]) -> list[Resolved]:
         """Every spring touching one of ``names``, once each."""
@@ -102,13 +98,12 @@ class SpringIndex:
     def length(self, spring: Resolved, default: float) -> float:
         """``l`` (m) of an angle spring: the natural length of the stiffest distance spring between its pivot
         and the place it turns (global: reference and figure; relative: vertex and its second place)."""
-        pivot, turned = spring.ends[-2:]
-        if (pivot, turned) not in self._lengths:
-            between = self._between.get(_pair(pivot, turned), {})
+        pair = _pair(*spring.ends[-2:])  # pivot and turned place
+        if pair not in self._lengths:
             # the stiffest; of equals, the first in field order (not the order the index met them in)
-            best = min(between, key=lambda s: (-s.stiffness, s.fields), default=None)
-            self._lengths[pivot, turned] = None if best is None else best.value
-        length = self._lengths[pivot, turned]
+            best = min(self._between.get(pair, {}), key=lambda s: (-s.stiffness, s.fields), default=None)
+            self._lengths[pair] = None if best is None else best.value
+        length = self._lengths[pair]
         return default if length is None else length
 
 

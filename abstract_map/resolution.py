@@ -186,7 +186,6 @@ def _resolved(spring: Spring, value: float) -> Resolved:
     return Resolved(spring.kind, spring.ends, value, spring.stiffness)
 
 
-
 @dataclass
 class _Structure:
     """The springs' kinds, ends and stiffnesses as arrays, appended as springs arrive."""

@@ -88,6 +88,9 @@ class Arrow:
     wrong_prob: float  # chance the arrow does not lead towards the goal
 
 
+_OFFSETS = np.asarray(MCP_Geometric(np.ones((3, 3)), fully_connected=True).offsets)  # (row, col) steps, 8-connected
+
+
 @dataclass
 class PathSearches:
     """Path-length searches kept between calls: a search from a cell over a cost grid is run again only when
@@ -95,30 +98,33 @@ class PathSearches:
 
     costs: dict[str, np.ndarray] = field(default_factory=dict)  # the cost grid of each kind of search
     found: dict[tuple[str, tuple[int, int]], tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
-    # (kind, start) -> lengths and predecessors
+    # (kind, start) -> lengths and scikit-image's traceback (an index into _OFFSETS per cell)
+    parents: dict[tuple[str, tuple[int, int]], np.ndarray] = field(default_factory=dict)  # worked out when asked
 
     def lengths(self, kind: str, costs: np.ndarray, start: tuple[int, int]) -> np.ndarray:
         """Cumulative cost (in cells of ``costs``) from ``start`` to every cell of ``costs`` (inf: cut off), by
         scikit-image's minimum-cost path, 8-connected."""
-        return self.tree(kind, costs, start)[0]
-
-    def tree(self, kind: str, costs: np.ndarray, start: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`lengths`, and each cell's predecessor on its shortest path from ``start`` (flat index into
-        ``costs``; ``start`` and cells cut off are their own)."""
         known = self.costs.get(kind)
         if known is None or known.shape != costs.shape or not np.array_equal(known, costs):
             self.costs[kind] = costs.copy()
             self.found = {key: value for key, value in self.found.items() if key[0] != kind}
+            self.parents = {key: value for key, value in self.parents.items() if key[0] != kind}
         if (kind, start) not in self.found:
-            mcp = MCP_Geometric(costs, fully_connected=True)
-            lengths, traceback = mcp.find_costs([start])
-            offsets = np.asarray(mcp.offsets)
+            self.found[kind, start] = MCP_Geometric(costs, fully_connected=True).find_costs([start])
+        return self.found[kind, start][0]
+
+    def tree(self, kind: str, costs: np.ndarray, start: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`lengths`, and each cell's predecessor on its shortest path from ``start`` (flat index into
+        ``costs``; ``start`` and cells cut off are their own)."""
+        lengths = self.lengths(kind, costs, start)
+        if (kind, start) not in self.parents:
+            traceback = self.found[kind, start][1]
             rows, cols = np.indices(costs.shape)
-            back = np.where(traceback >= 0, traceback, 0)
-            pred = (rows - offsets[back, 0]) * costs.shape[1] + (cols - offsets[back, 1])
-            pred = np.where((traceback >= 0) & np.isfinite(lengths), pred, np.arange(costs.size).reshape(costs.shape))
-            self.found[kind, start] = (lengths, pred.ravel())
-        return self.found[kind, start]
+            step = _OFFSETS[np.where(traceback >= 0, traceback, 0)]
+            pred = (rows - step[..., 0]) * costs.shape[1] + (cols - step[..., 1])
+            own = np.arange(costs.size).reshape(costs.shape)
+            self.parents[kind, start] = np.where((traceback >= 0) & np.isfinite(lengths), pred, own).ravel()
+        return lengths, self.parents[kind, start]
 
 
 def _cell(grid: OccupancyGrid, pool: int, blocked: np.ndarray, xy: np.ndarray) -> tuple[int, int] | None:
@@ -170,8 +176,7 @@ def first_leg_points(lengths: np.ndarray, pred: np.ndarray, lead: float) -> np.n
     """Per cell (flat), the cell where its shortest path from the search's start first leaves the ``lead``
     (cells of path) around it: the first ancestor within ``lead`` (the cell itself when within). By pointer
     jumping: each round doubles how far back a cell looks."""
-    inside = ~(lengths > lead)  # within the lead, or cut off (kept as itself)
-    jump = np.where(inside, np.arange(len(lengths)), pred)
+    jump = np.where(lengths <= lead, np.arange(len(lengths)), pred)  # a cell cut off is its own predecessor
     for _ in range(64):
         nxt = jump[jump]
         if np.array_equal(nxt, jump):
