@@ -22,11 +22,12 @@ import numpy as np
 from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
 from sim.navigation.belief import BeliefParams
 from sim.navigation.follower import FollowerParams
+from sim.navigation.gateways import GuideParams
 from sim.navigation.navigator import CueEvent, NavigatorParams
 from sim.navigation.planner import PlannerParams
 from sim.navigation.policies import NAVIGATORS, PolicyParams, make_policy
 from sim.navigation.replanner import ReplanParams
-from sim.navigation.routes import GuideParams, RouteParams
+from sim.navigation.routes import RouteParams
 from sim.navigation.targeting import TargetParams
 from sim.navigation.viewpoints import ViewpointParams
 from sim.perception import PERCEPTION_MODES, GeometricParams, Sighting, make_perception

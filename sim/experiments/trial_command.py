@@ -41,8 +41,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--navigator", default="paper",
                         help="navigation policy: paper (the paper's robot, reads signs; default), frontier "
                              "(nearest frontier, reads no sign: the no-signs lower bound), viewpoint (negative "
-                             "information: to where the goal's label may still be read) or guided (the nearest "
-                             "frontier weighed by what the arrows, doorways and abstract map say)")
+                             "information: to where the goal's label may still be read) or guided (the frontier "
+                             "with the most goal belief behind it per metre, from the arrows, signs, doorways and "
+                             "abstract map)")
     parser.add_argument("--out", type=Path, required=True, help="output folder")
     parser.add_argument("--record", action="store_true", help="also write DIR/run.gif, an animation of the run")
     parser.add_argument("--log", type=Path, metavar="FILE.rrd",

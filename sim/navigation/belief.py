@@ -21,6 +21,7 @@ See ``docs/method-notes.md`` (negative information) for the equations.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,6 +46,8 @@ class BeliefParams:
     # buildings the imagined goal lies a median of several metres from its label, often beyond a wall
     sigma_per_m: float = 0.35  # m of spread per m between the imagined goal and the nearest observed anchor
     label_offset_m: float = 2.0  # m, a place's label hangs about this far from the place (level-1 label length)
+    prior_misses: float = 3.0  # how many of the model's misses (below) the spread from ``sigma_min_m`` and
+    # ``sigma_per_m`` counts as: a few labels read decide how far the model is trusted in this building
     tail_weight: float = 0.3  # share of the prior in a wide tail: the model may be wrong (a sign misread, a guess)
     tail_scale: float = 3.0  # the tail's spread, in multiples of sigma
 
@@ -196,13 +199,22 @@ class Belief:
     sigma_m: float  # m, the prior's spread
 
 
-def goal_sigma(goal_xy: np.ndarray, anchors_xy: np.ndarray, params: BeliefParams) -> float:
-    """Spread (m) of the goal's prior: the label offset, plus a share of the distance to the nearest observed
-    anchor (a tag read, or the start), in quadrature with the minimum."""
+def goal_sigma(goal_xy: np.ndarray, anchors_xy: np.ndarray, params: BeliefParams,
+               misses_m: Sequence[float] = ()) -> float:
+    """Spread (m) of the goal's prior.
+
+    Before any miss, the label offset in quadrature with a share of the distance to the nearest observed anchor
+    (a tag read, or the start), at least ``sigma_min_m``. ``misses_m`` are the model's own misses in this
+    building (m): how far each label read lay from where the model imagined its place just before. They
+    replace that guess as they come: with ``n`` misses ``e_i`` and the guess counted as ``prior_misses`` of
+    them, ``sigma^2 = (n0 guess^2 + sum e_i^2 / 2) / (n0 + n)`` (a miss in the plane has mean square
+    ``2 sigma^2``)."""
     anchors = np.atleast_2d(np.asarray(anchors_xy, dtype=float))
     nearest = float(np.min(np.hypot(*(anchors - goal_xy).T))) if anchors.size else 0.0
     spread = max(params.sigma_min_m, params.sigma_per_m * nearest)
-    return math.hypot(spread, params.label_offset_m)
+    guess = math.hypot(spread, params.label_offset_m)
+    n0, misses = params.prior_misses, np.asarray(misses_m, dtype=float)
+    return math.sqrt((n0 * guess ** 2 + float(np.sum(misses ** 2)) / 2) / (n0 + len(misses)))
 
 
 def goal_belief(grid: OccupancyGrid, swept: np.ndarray, goal_xy: np.ndarray, sigma_m: float,

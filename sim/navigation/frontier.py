@@ -202,11 +202,13 @@ def find_frontiers(grid: OccupancyGrid, robot_xy: np.ndarray, robot_radius_m: fl
 
 def nearest_frontier(grid: OccupancyGrid, robot_xy: np.ndarray, robot_radius_m: float, params: FrontierParams,
                      visited: list[np.ndarray] | None = None, covered: np.ndarray | None = None,
-                     penalty_m: np.ndarray | None = None) -> np.ndarray | None:
+                     value: np.ndarray | None = None, offset_m: float = 0.0, floor: float = 1e-6
+                     ) -> np.ndarray | None:
     """The reachable frontier cell (m) nearest the robot by path, away from ``visited``; None if none is left.
 
-    ``penalty_m`` (the grid's shape, m) is added to each cell's path length: a guided search's cost of
-    going where the cues say the goal is unlikely."""
+    With ``value`` (the grid's shape, >= 0: what reaching each cell is worth) the cell of least
+    ``(path + offset_m) / value`` instead: the most value per metre, a value below ``floor`` times the best
+    counting as that (nowhere is ruled out)."""
     found = find_frontiers(grid, robot_xy, robot_radius_m, params, covered)
     candidates = found.mask & np.isfinite(found.distance_m) & (found.distance_m >= params.min_distance_m)
     cells = np.argwhere(candidates)
@@ -221,8 +223,9 @@ def nearest_frontier(grid: OccupancyGrid, robot_xy: np.ndarray, robot_radius_m: 
         if cells.size == 0:
             return None
     cost = found.distance_m[cells[:, 0], cells[:, 1]]
-    if penalty_m is not None:
-        cost = cost + penalty_m[cells[:, 0], cells[:, 1]]
+    if value is not None:
+        worth = value[cells[:, 0], cells[:, 1]]
+        cost = (cost + offset_m) / np.maximum(worth, floor * max(float(worth.max()), 1e-300))
     return xy[int(np.argmin(cost))]
 
 

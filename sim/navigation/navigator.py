@@ -58,6 +58,8 @@ class Navigator:
     settles: list[SettleReport] = field(default_factory=list)
     bumps_in_a_row: int = 0
     succeeded: bool = False
+    misses_m: list[float] = field(default_factory=list)  # per label read first, how far (m) it lay from where
+    # the model imagined its place just before: the model's track record in this building
 
     @classmethod
     def start(cls, world: World, goal: str, start_pose: tuple[float, float, float], *,
@@ -99,6 +101,8 @@ class Navigator:
             tag = self.world.tags.get(s.tag_id)
             if tag is None or tag.kind == "empty":
                 continue
+            if tag.kind == "label":
+                self._record_miss(tag.text, s.x, s.y)
             observation = self.model.observe_tag(tag.id, tag.text, (s.x, s.y, s.theta), kind=tag.kind)
             if observation.new:
                 new.append(tag)
@@ -113,6 +117,14 @@ class Navigator:
                                       report.wall_s))
             log.info("t=%.1fs read tag %d %r", t_s, tag.id, tag.text)
         return True
+
+    def _record_miss(self, text: str, x: float, y: float) -> None:
+        """Note how far a label read at (``x``, ``y``) (m) lies from its place as imagined, if the model imagined
+        that place and had not yet observed it."""
+        place = self.model.canonical(text)
+        if place in self.model.positions and not self.model.is_observed(place):
+            imagined = self.model.positions[place]
+            self.misses_m.append(float(np.hypot(imagined[0] - x, imagined[1] - y)))
 
     def settle(self, explored_centre: tuple[float, float] | None) -> SettleReport:
         if explored_centre is not None:

@@ -17,6 +17,9 @@ differs is where it wants to go. Register a new one in :data:`NAVIGATORS`.
   reads the most of it per metre; the model grows when the belief near the
   imagined goal is used up, and unswept wall near the robot draws it when the
   cues say little (see ``docs/method-notes.md``).
+- ``guided``: a frontier search like ``frontier``'s, reading signs: the frontier
+  with the most of that goal belief behind it per metre of path
+  (:mod:`sim.navigation.gateways`).
 """
 
 from __future__ import annotations
@@ -34,10 +37,18 @@ from sim.mapping.occupancy import OccupancyGrid
 from sim.navigation.belief import Belief, BeliefParams, SweptSpace, cue_mass, goal_belief, goal_sigma
 from sim.navigation.follower import FollowerParams, PathFollower, Recovery, RecoveryParams, StuckDetector, StuckParams
 from sim.navigation.frontier import FrontierParams, LookedAt, nearest_frontier, still_frontier
+from sim.navigation.gateways import GuideParams, frontier_values
 from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
 from sim.navigation.planner import Plan, PlannerParams
 from sim.navigation.replanner import Replanner, ReplanParams
-from sim.navigation.routes import Arrow, GuideParams, PathSearches, RouteParams, door_depth_weight, route_likelihood
+from sim.navigation.routes import (
+    Arrow,
+    PathSearches,
+    RouteParams,
+    door_depth_weight,
+    passed_likelihood,
+    route_likelihood,
+)
 from sim.navigation.targeting import Target, TargetParams, choose_target
 from sim.navigation.viewpoints import ViewpointParams, Viewpoints, score_viewpoints, travel_costs
 from sim.perception.sighting import Sighting
@@ -131,7 +142,7 @@ class AbstractMapPolicy:
         self.start = np.asarray(start, dtype=float)
         self.depth = np.ones(1)  # door-depth weight per grid cell (sim.navigation.routes), set with the belief
         self.evidence: np.ndarray | None = None  # depth x route likelihood, per grid cell
-        self.evidence_key: tuple[Arrow, ...] = ()
+        self.evidence_key: tuple = ()  # the arrows and unnamed signs the evidence was worked out from
         self.evidence_at = -float("inf")
         self.evidence_count = 0  # refreshes of the evidence so far (what was worked out from it knows its age)
         self.searches = PathSearches()  # the evidence's path searches, run again only on a changed map
@@ -158,15 +169,20 @@ class AbstractMapPolicy:
         (m) the model earns there (:func:`sim.navigation.belief.goal_sigma`)."""
         goal = self.nav.model.goal_estimate()
         anchors = np.array([f.xy for f in self.nav.model.fixed.values()])
-        return goal, goal_sigma(goal, anchors, self.params.belief)
+        return goal, goal_sigma(goal, anchors, self.params.belief, self.nav.misses_m)
+
+    def _areas(self) -> set[str]:
+        """The places that hold the goal, up the hierarchy."""
+        model, areas, place = self.nav.model, set(), self.nav.goal
+        while place in model.hierarchy.parent and place not in areas:
+            place = model.hierarchy.parent[place]
+            areas.add(place)
+        return areas
 
     def arrows(self) -> list[Arrow]:
         """Every arrow read that names the goal, or an area holding it (less surely)."""
         model, rp = self.nav.model, self.params.routes
-        areas, place = set(), self.nav.goal
-        while place in model.hierarchy.parent and place not in areas:
-            place = model.hierarchy.parent[place]
-            areas.add(place)
+        areas = self._areas()
         out = []
         for clause in model.clauses():
             if not isinstance(clause, Locational) or clause.kind != "arrow" or clause.anchor not in model.fixed:
@@ -177,16 +193,37 @@ class AbstractMapPolicy:
                 out.append(Arrow((sign.x, sign.y), sign.theta, clause.direction, wrong))
         return out
 
+    def unnamed(self) -> list[tuple[float, float]]:
+        """Where the reader of each sign read stands (m, ``RouteParams.stand_m`` in front of it) that has an
+        arrow and names neither the goal nor an area holding it, in an arrow or a phrase."""
+        model, stand = self.nav.model, self.params.routes.stand_m
+        wanted = self._areas() | {self.nav.goal}
+        out = []
+        for anchor, clauses in model.cue_clauses.items():
+            sign = model.fixed.get(anchor)
+            if sign is None or not any(isinstance(c, Locational) and c.kind == "arrow" for c in clauses):
+                continue
+            named = {name for c in clauses for name in (
+                (c.toponym,) if isinstance(c, Locational) else (c.figure, *c.referents, c.context))}
+            if not {model.canonical(name) for name in named if name} & wanted:
+                out.append((sign.x + stand * math.cos(sign.theta), sign.y + stand * math.sin(sign.theta)))
+        return out
+
     def _evidence(self, grid: OccupancyGrid) -> np.ndarray:
-        """Door depth x route likelihood of the arrows read, per grid cell; refreshed when a new arrow is read
-        or every ``evidence_every_s`` (walls and doors are mapped slowly)."""
-        arrows = self.arrows()
-        key = tuple(arrows)
+        """Door depth x route likelihood of the arrows read x that of the signs not naming the goal, per grid
+        cell; refreshed when a new sign is read or every ``evidence_every_s`` (walls and doors are mapped
+        slowly)."""
+        arrows, unnamed = self.arrows(), self.unnamed()
+        key = (*arrows, *unnamed)
         if self.evidence is None or key != self.evidence_key or self.now - self.evidence_at >= \
                 self.params.routes.evidence_every_s:
-            self.depth = door_depth_weight(grid, self.start[:2], self.params.routes, self.searches)
-            likelihood = route_likelihood(grid, arrows, self.params.routes, self.searches)
-            self.evidence = self.depth if likelihood is None else self.depth * likelihood
+            rp = self.params.routes
+            self.depth = door_depth_weight(grid, self.start[:2], rp, self.searches)
+            self.evidence = self.depth
+            for likelihood in (route_likelihood(grid, arrows, rp, self.searches),
+                               passed_likelihood(grid, unnamed, self.start[:2], rp, self.searches)):
+                if likelihood is not None:
+                    self.evidence = self.evidence * likelihood
             self.evidence_key, self.evidence_at = key, self.now
             self.evidence_count += 1
         return self.evidence
@@ -246,9 +283,10 @@ class FrontierSearch:
         self.exhausted = False
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float, rng: np.random.Generator,
-                penalty: Callable[[], np.ndarray | None] = lambda: None) -> tuple[float, float]:
-        """The wheel command (m/s, rad/s) towards the frontier of least path length plus ``penalty()`` (m per
-        grid cell, or None)."""
+                value: Callable[[np.ndarray], np.ndarray | None] = lambda covered: None,
+                offset_m: float = 0.0) -> tuple[float, float]:
+        """The wheel command (m/s, rad/s) towards the frontier of least path length, or with ``value(covered)``
+        (per grid cell, given the cells looked at; None: path alone) of least ``(path + offset_m) / value``."""
         radius = self.params.planner.robot_radius_m
         covered = self.looked.update(grid, np.array(pose[:2]), self.frontier)
         if self.target is not None and t_s - self.checked_at >= self.frontier.recheck_s:
@@ -257,7 +295,7 @@ class FrontierSearch:
                 self.target = None
         if self.target is None or t_s - self.chosen_at >= self.rechoose_s:
             self.target = nearest_frontier(grid, np.array(pose[:2]), radius, self.frontier, self.visited, covered,
-                                           penalty_m=penalty())
+                                           value=value(covered), offset_m=offset_m)
             self.chosen_at = self.checked_at = t_s
             self.drive.replanner.request()
             if self.target is None:
@@ -278,7 +316,7 @@ class FrontierPolicy:
     """Explore without reading signs: the nearest reachable frontier, until the goal's label is read.
 
     The trial judges success from the goal's label, so this policy ignores every
-    sighting (:class:`FrontierSearch` with no penalty).
+    sighting (:class:`FrontierSearch` by path length alone).
     """
 
     goal_blind = True  # its path never depends on the goal, so one run can stand for every goal of a world
@@ -392,48 +430,42 @@ class ViewpointPolicy(AbstractMapPolicy):
 
 
 class GuidedPolicy(AbstractMapPolicy):
-    """Sign-guided frontier search: the frontier nearest by path plus a penalty for what the cues say.
+    """Sign-guided frontier search: the frontier with the most goal belief behind it per metre of path.
 
-    The cost of a frontier cell is its path length plus ``penalty_m`` per e-fold
-    by which the evidence there falls short of the best: the abstract map's
-    imagined goal (the belief's Gaussian prior), every arrow read that names the
-    goal or an area holding it, and the doorways between the start and that
-    cell (:mod:`sim.navigation.routes`). Space counts as explored once looked at
-    from within reading range, as for ``frontier``; the goal is found when its
-    label is read. It gives up when no frontier is left.
+    The belief over where the goal's label hangs is the viewpoint policy's
+    (:func:`sim.navigation.belief.goal_belief`): the abstract map's imagined goal
+    as a prior, as wide as the model's own misses in this building, times every
+    arrow read that names the goal or an area holding it
+    and the doorways between the start and each place
+    (:mod:`sim.navigation.routes`), on mapped walls more than in unseen space,
+    and little where the robot has already looked. Each frontier is worth the
+    belief whose route from the robot enters unlooked space through it
+    (:func:`sim.navigation.gateways.frontier_values`), so a corridor's open end
+    carries all it leads to and a room's doorway only the room. The search is
+    complete: it ends when the goal's label is read or no frontier is left.
     """
 
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
         super().__init__(world, goal, start, params)
         frontier = replace(FrontierParams(), min_distance_m=params.guide.min_target_m)
         self.search = FrontierSearch(params, self.drive, frontier, params.guide.rechoose_s)
-        self.penalty: tuple[tuple, np.ndarray] | None = None  # the latest penalty and what it was worked out from
+        self.belief: Belief | None = None  # the latest goal belief, for drawing
 
     def forget_target(self) -> None:
         self.search.target = None
 
-    def _penalty(self, grid: OccupancyGrid) -> np.ndarray:
-        """Per grid cell, the guide's penalty (m): ``penalty_m`` x -ln(evidence / its peak); worked out again only
-        when the imagined goal, its spread or the evidence changed."""
-        bp, gp = self.params.belief, self.params.guide
+    def _values(self, grid: OccupancyGrid, covered: np.ndarray, robot_xy: np.ndarray) -> np.ndarray:
+        """Per grid cell, the goal belief behind it (:func:`sim.navigation.gateways.frontier_values`)."""
         goal, sigma = self.goal_prior()
-        layer = self._evidence(grid)
-        key = (float(goal[0]), float(goal[1]), float(sigma), self.evidence_count, grid.shape)
-        if self.penalty is not None and self.penalty[0] == key:
-            return self.penalty[1]
-        x, y = grid.cell_axes()
-        d2 = (y[:, None] - goal[1]) ** 2 + (x[None, :] - goal[0]) ** 2
-        wide = bp.tail_scale * sigma
-        prior = (1 - bp.tail_weight) * np.exp(-0.5 * d2 / sigma ** 2) + bp.tail_weight * np.exp(-0.5 * d2 / wide ** 2)
-        evidence = prior * layer
-        penalty = gp.penalty_m * -np.log(np.maximum(evidence / max(float(evidence.max()), 1e-300), gp.floor))
-        self.penalty = (key, penalty)
-        return penalty
+        self.belief = goal_belief(grid, covered, goal, sigma, self.params.belief, self._evidence(grid))
+        return frontier_values(grid, self.belief.mass, covered, robot_xy, self.params.guide, self.params.routes)
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:
         self.now = t_s
-        v, w = self.search.command(t_s, pose, grid, tick_s, rng, penalty=lambda: self._penalty(grid))
+        robot_xy = np.array(pose[:2])
+        v, w = self.search.command(t_s, pose, grid, tick_s, rng, value=lambda covered: self._values(
+            grid, covered, robot_xy), offset_m=self.params.guide.offset_m)
         if self.search.exhausted:
             self.gave_up = NO_FRONTIER
         return v, w
@@ -443,10 +475,11 @@ class GuidedPolicy(AbstractMapPolicy):
         return dict(imagined_positions(self.nav.model)), self.search.shown(), None if plan is None else plan.waypoints
 
     def layers(self) -> dict[str, np.ndarray]:
-        """For drawing, on the occupancy grid's cells: the evidence (depth x arrows) and the space looked at."""
+        """For drawing, on the occupancy grid's cells: the goal belief (scaled to its peak) and the space looked at."""
         out: dict[str, np.ndarray] = {}
-        if self.evidence is not None and self.evidence.size > 1:
-            out["belief"] = self.evidence
+        if self.belief is not None:
+            peak = float(self.belief.mass.max())
+            out["belief"] = self.belief.mass / peak if peak > 0 else self.belief.mass
         if self.search.looked.covered is not None:
             out["swept"] = self.search.looked.covered
         return out

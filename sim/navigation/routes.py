@@ -57,6 +57,11 @@ class RouteParams:
     wrong_prob: float = 0.1  # chance an arrow naming the goal is wrong ("misleading" signage: one in ten)
     area_wrong_prob: float = 0.35  # for an arrow naming an area holding the goal: the goal may lie off the
     # area's route (a wing's arrow leads to its nearest room, not to every room of it)
+    named_prob: float = 0.7  # chance that a sign on the goal's route names it or an area holding it: the generator's
+    # complete signage names 171 of 172 (worlds/README.md), its sparse signage half by area only; hand-made
+    # buildings name fewer (the zoo's signs list a few places each)
+    junction_m: float = 2.0  # m from a sign's reader within which a route counts as passing the sign (a junction
+    # of corridors up to 3 m wide)
     door_width_m: float = 1.3  # m; narrower passages are doorways (doors are ~1 m, corridors 1.8 m and wider)
     robot_radius_m: float = 0.38  # m; narrower than twice this is no passage at all (the planner's radius)
     door_penalty_m: float = 10.0  # m of route cost per metre walked through a doorway's narrows (counts doors)
@@ -65,17 +70,6 @@ class RouteParams:
     front_m: float = 1.2  # m; a wall is weighed by the shallowest space this close in front of it
     evidence_every_s: float = 8.0  # s between refreshing depth and route evidence (sooner on a new arrow)
     depth_pool: int = 2  # doorways are counted on cells this many times the grid's (0.2 m: a door stays narrow)
-
-
-@dataclass(frozen=True)
-class GuideParams:
-    """How the guided search trades path length against what the cues say (``--navigator guided``)."""
-
-    penalty_m: float = 8.0  # m of path worth one e-fold of evidence: a room behind a door (x0.15) costs 15 m more,
-    # a place against an arrow (x0.1) 18 m more
-    floor: float = 1e-4  # evidence below this counts as this (a cap on the penalty: nowhere is ruled out)
-    rechoose_s: float = 5.0  # s between choosing the frontier afresh (the evidence changes as the map grows)
-    min_target_m: float = 1.0  # m; frontiers nearer than this by path are skipped (the robot sees them as it goes)
 
 
 @dataclass(frozen=True)
@@ -127,8 +121,9 @@ class PathSearches:
         return lengths, self.parents[kind, start]
 
 
-def _cell(grid: OccupancyGrid, pool: int, blocked: np.ndarray, xy: np.ndarray) -> tuple[int, int] | None:
-    """The open coarse cell nearest to ``xy`` (m), or None when the grid has none."""
+def open_cell(grid: OccupancyGrid, pool: int, blocked: np.ndarray, xy: np.ndarray) -> tuple[int, int] | None:
+    """The open cell of ``blocked`` (``grid``'s cells pooled ``pool`` x ``pool``) nearest to ``xy`` (m), or None
+    when it has none."""
     rc = grid.world_to_cell(xy)[0] // pool
     rows, cols = blocked.shape
     rc = np.clip(rc, 0, [rows - 1, cols - 1])
@@ -155,7 +150,7 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
     tolerance, spread = math.radians(params.tolerance_deg), math.radians(params.spread_deg)
     for arrow in arrows:
         sign = np.asarray(arrow.sign_xy, dtype=float)
-        stand = _cell(grid, pool, blocked, sign + params.stand_m * np.array([math.cos(arrow.facing),
+        stand = open_cell(grid, pool, blocked, sign + params.stand_m * np.array([math.cos(arrow.facing),
                                                                             math.sin(arrow.facing)]))
         if stand is None:
             continue
@@ -172,17 +167,55 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
     return fine / float(fine.max())
 
 
+def passed_likelihood(grid: OccupancyGrid, readers: Iterable[tuple[float, float]], start_xy: np.ndarray,
+                      params: RouteParams = RouteParams(), searches: PathSearches | None = None) -> np.ndarray | None:
+    """Per cell of ``grid``, the likelihood that signs read at ``readers`` (where each sign's reader stands, m)
+    named neither the goal nor an area holding it, given the goal there: ``1 - named_prob`` where the cell's
+    shortest route from ``start_xy`` (m; over the robot's map, unseen space open) passes within ``junction_m``
+    of a reader and ends beyond it, 1 elsewhere; scaled to a peak of 1; None with no reader.
+
+    Signs name the places whose routes pass them, so a sign that does not name the goal says the goal lies off
+    the ways it stands on."""
+    searches = PathSearches() if searches is None else searches
+    readers = [np.asarray(r, dtype=float) for r in readers]
+    if not readers:
+        return None
+    pool = max(1, round(params.cell_m / grid.resolution))
+    blocked = pool_cells(grid.occupied_mask(), pool, False, np.any)
+    start = open_cell(grid, pool, blocked, np.asarray(start_xy, dtype=float))
+    if start is None:
+        return None
+    lengths, pred = searches.tree("route", np.where(blocked, np.inf, 1.0), start)
+    step = pool * grid.resolution
+    rows, cols = np.indices(blocked.shape)
+    x0, y0 = grid.origin
+    xs = x0 + (cols + 0.5) * step
+    ys = y0 + (grid.shape[0] - (rows + 0.5) * pool) * grid.resolution
+    total = np.ones(blocked.shape)
+    for reader in readers:
+        near = (np.hypot(xs - reader[0], ys - reader[1]) <= params.junction_m).ravel() & np.isfinite(lengths.ravel())
+        through = near[follow_pointers(np.where(near, np.arange(near.size), pred))].reshape(blocked.shape)
+        total *= np.where(through & ~near.reshape(blocked.shape), 1.0 - params.named_prob, 1.0)
+    fine = unpool_cells(total, pool, grid.shape)
+    return fine / float(fine.max())
+
+
 def first_leg_points(lengths: np.ndarray, pred: np.ndarray, lead: float) -> np.ndarray:
     """Per cell (flat), the cell where its shortest path from the search's start first leaves the ``lead``
     (cells of path) around it: the first ancestor within ``lead`` (the cell itself when within). By pointer
     jumping: each round doubles how far back a cell looks."""
-    jump = np.where(lengths <= lead, np.arange(len(lengths)), pred)  # a cell cut off is its own predecessor
+    return follow_pointers(np.where(lengths <= lead, np.arange(len(lengths)), pred))  # cut off: its own
+
+
+def follow_pointers(jump: np.ndarray) -> np.ndarray:
+    """Per index, where following ``jump`` (an index per index) ends: at an index that points to itself. By
+    pointer jumping, each round doubling how far an index looks; a ValueError when the pointers form a cycle."""
     for _ in range(64):
         nxt = jump[jump]
         if np.array_equal(nxt, jump):
             return jump
         jump = nxt
-    raise RuntimeError("first_leg_points: predecessors form a cycle")
+    raise ValueError("follow_pointers: the pointers form a cycle")
 
 
 def door_depth_weight(grid: OccupancyGrid, start_xy: np.ndarray, params: RouteParams = RouteParams(),

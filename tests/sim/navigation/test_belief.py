@@ -69,6 +69,18 @@ def test_goal_spread_grows_with_distance_from_evidence():
     assert near < far
 
 
+def test_goal_spread_follows_the_models_own_misses():
+    """The spread starts from the guess and moves to the misses' per-axis rms as labels are read."""
+    params = BeliefParams()
+    goal, anchors = np.array([1.0, 0.0]), np.array([[0.0, 0.0]])
+    guess = goal_sigma(goal, anchors, params)
+    assert goal_sigma(goal, anchors, params, []) == pytest.approx(guess)
+    wide = goal_sigma(goal, anchors, params, [20.0] * 3)
+    assert wide == pytest.approx(np.sqrt((3 * guess ** 2 + 3 * 200.0) / 6))
+    assert goal_sigma(goal, anchors, params, [20.0] * 300) == pytest.approx(20.0 / np.sqrt(2), rel=0.02)
+    assert goal_sigma(goal, anchors, params, [1.0] * 30) < guess
+
+
 def test_cue_mass_is_unswept_wall_near_the_robot():
     grid, params = corridor(), BeliefParams()
     mass = cue_mass(grid, np.zeros(grid.shape, dtype=bool), np.array([3.0, 4.0]), 4.0, params)

@@ -34,6 +34,16 @@ def test_a_sign_moves_the_goal_and_its_label_ends_the_trial(tiny_world):
     assert nav.succeeded and nav.model.is_observed("A")
 
 
+def test_a_label_read_records_how_far_the_model_missed_its_place(tiny_world):
+    nav = Navigator.start(tiny_world, "A", tiny_world.start)
+    imagined = nav.model.position("A")
+    tag = tiny_world.tags[0]
+    nav.observe([sighting(tiny_world, 0)], t_s=1.0, distance_m=0.5, explored_centre=lambda: None)
+    assert nav.misses_m == [pytest.approx(float(np.hypot(imagined[0] - tag.x, imagined[1] - tag.y)))]
+    nav.observe([sighting(tiny_world, 0)], t_s=2.0, distance_m=0.6, explored_centre=lambda: None)
+    assert len(nav.misses_m) == 1  # a place already observed is no prediction
+
+
 def test_empty_and_unknown_tags_are_ignored(tiny_world):
     nav = Navigator.start(tiny_world, "A", tiny_world.start)
     assert not nav.observe([sighting(tiny_world, 3), Sighting(99, 0.0, 0.0, 0.0, 1.0)], t_s=0.0,

@@ -8,7 +8,14 @@ import numpy as np
 import pytest
 
 from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
-from sim.navigation.routes import Arrow, PathSearches, RouteParams, door_depth_weight, route_likelihood
+from sim.navigation.routes import (
+    Arrow,
+    PathSearches,
+    RouteParams,
+    door_depth_weight,
+    passed_likelihood,
+    route_likelihood,
+)
 
 
 def grid_of(walls: list[tuple[float, float, float, float]], size: tuple[float, float] = (20.0, 12.0)
@@ -137,3 +144,26 @@ def test_on_a_mapped_building_every_true_arrow_favours_the_place_it_names(style)
                 assert at(grid, route_likelihood(grid, [arrow]), *front) > 0.4, (tag.id, word, name)
                 checked += 1
     assert checked >= 5
+
+
+def test_a_sign_not_naming_the_goal_discounts_what_lies_beyond_it_on_the_way_from_the_start():
+    """Open floor, the start at (2, 6), a sign's reader at (10, 6): routes from the start that pass within
+    ``junction_m`` of the reader and end beyond it lose ``named_prob``; routes that miss it, or end before it,
+    keep all of theirs."""
+    grid = grid_of([])
+    params = RouteParams()
+    likelihood = passed_likelihood(grid, [(10.0, 6.0)], np.array([2.0, 6.0]), params)
+    assert likelihood is not None and float(likelihood.max()) == pytest.approx(1.0)
+    assert at(grid, likelihood, 16.0, 6.0) == pytest.approx(1.0 - params.named_prob)  # beyond it
+    assert at(grid, likelihood, 9.0, 11.5) == pytest.approx(1.0)  # the route passes about 4 m off
+    assert at(grid, likelihood, 5.0, 6.0) == pytest.approx(1.0)  # before it
+    assert passed_likelihood(grid, [], np.array([2.0, 6.0])) is None
+
+
+def test_a_sign_not_naming_the_goal_says_nothing_of_a_branch_the_route_leaves_before_it():
+    """A wall along y = 4 from x = 0 to 12, open at its east end: places north of the wall are reached round its
+    end at x 12..20, past a reader at (13, 3); the places south of it (x < 12) are reached directly."""
+    grid = grid_of([(0.0, 12.0, 4.0, 4.2)])
+    likelihood = passed_likelihood(grid, [(13.0, 3.0)], np.array([2.0, 2.0]))
+    assert at(grid, likelihood, 4.0, 8.0) == pytest.approx(1.0 - RouteParams().named_prob)  # round the wall's end
+    assert at(grid, likelihood, 8.0, 1.0) == pytest.approx(1.0)

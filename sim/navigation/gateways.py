@@ -1,0 +1,75 @@
+"""What lies behind each frontier: belief mass gathered by the frontier its route enters through.
+
+A frontier is where space looked at meets space not yet looked at. The goal's
+label may hang anywhere not yet looked at, weighted by a belief ``b`` (per
+grid cell, :class:`sim.navigation.policies.GuidedPolicy`). The robot would
+reach a place ``x`` by its shortest route over its own map (mapped walls
+block, unseen space is open), and that route enters space not yet looked at
+at one cell, its *gateway* ``g(x)``. A frontier cell ``f`` is worth the mass
+whose gateway lies within ``gather_m`` of it:
+
+    V(f) = sum over x with |g(x) - f| <= gather_m of b(x)
+
+So the open end of a corridor carries everything the corridor leads to, and a
+room's doorway only the room. Mass on a mapped wall cell (where labels hang)
+counts at the wall's neighbouring cell that the robot reaches first. World
+frame, metres; routes are searched on cells of ``RouteParams.cell_m``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from sim.mapping.occupancy import OccupancyGrid, pool_cells, unpool_cells
+from sim.navigation.routes import PathSearches, RouteParams, follow_pointers, open_cell
+
+WALL_CELLS = 1e4  # route cost of a wall cell, in open cells: more than any route through open space
+
+
+@dataclass(frozen=True)
+class GuideParams:
+    """How the guided search values frontiers (``--navigator guided``)."""
+
+    gather_m: float = 0.9  # m; a frontier cell lies within the robot's reach (0.3 m) plus a door's half width
+    # of the unlooked-at cells its space opens onto, so a doorway's frontier gathers the whole doorway
+    looked_share: float = 0.5  # share of a route cell's fine cells looked at for it to count as looked at
+    offset_m: float = 3.0  # m added to a frontier's path before dividing by its value: what must be walked past
+    # it to look behind it (the look radius), so a frontier at the robot's feet is not worth without bound
+    floor: float = 1e-6  # a value below this share of the best counts as this (nowhere is ruled out)
+    rechoose_s: float = 5.0  # s between choosing the frontier afresh (the evidence changes as the map grows)
+    min_target_m: float = 1.0  # m; frontiers nearer than this by path are skipped (the robot sees them as it goes)
+
+
+def frontier_values(grid: OccupancyGrid, mass: np.ndarray, looked: np.ndarray, robot_xy: np.ndarray,
+                    params: GuideParams = GuideParams(), routes: RouteParams | None = None) -> np.ndarray:
+    """Per cell of ``grid``, the belief mass ``V`` (same units as ``mass``) whose route from ``robot_xy`` (m)
+    enters space not yet ``looked`` at within ``gather_m`` of that cell.
+
+    ``mass`` and ``looked`` have the grid's shape. Mass the robot cannot reach over its map (cut off, or inside
+    a wall with no open neighbour) is in no frontier's value.
+    """
+    routes = RouteParams() if routes is None else routes
+    pool = max(1, round(routes.cell_m / grid.resolution))
+    step = pool * grid.resolution
+    blocked = pool_cells(grid.occupied_mask(), pool, False, np.any)
+    coarse = pool_cells(np.asarray(mass, dtype=float), pool, 0.0, np.sum)
+    unlooked = pool_cells(looked.astype(np.float32), pool, np.float32(0.0), np.mean) < params.looked_share
+    start = open_cell(grid, pool, blocked, np.asarray(robot_xy, dtype=float))
+    if start is None:
+        return np.zeros(grid.shape)
+    # Walls cost WALL_CELLS per cell, so a wall cell is reached from its open side nearest the robot by route
+    # (the side a label there is read from) while no route through open space crosses one.
+    lengths, pred = PathSearches().tree("robot", np.where(blocked, WALL_CELLS, 1.0), start)
+    counted = np.where(blocked, lengths < 3 * WALL_CELLS, lengths < WALL_CELLS)  # a wall's face, not beyond it
+    carried = np.where(counted, coarse, 0.0).ravel()
+    # Each cell's gateway: the first cell on its route not yet looked at (a looked-at cell is its own).
+    flat_unlooked = unlooked.ravel()
+    own = np.arange(coarse.size)
+    gateway = follow_pointers(np.where(flat_unlooked & flat_unlooked[pred], pred, own))
+    value = np.bincount(gateway, carried, minlength=coarse.size).reshape(blocked.shape)
+    reach = max(0, int(round(params.gather_m / step)))
+    gathered = ndimage.uniform_filter(value, size=2 * reach + 1, mode="constant") * (2 * reach + 1) ** 2
+    return unpool_cells(np.maximum(gathered, 0.0), pool, grid.shape)
