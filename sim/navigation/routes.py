@@ -172,7 +172,8 @@ def passed_likelihood(grid: OccupancyGrid, readers: Iterable[tuple[float, float]
     """Per cell of ``grid``, the likelihood that signs read at ``readers`` (where each sign's reader stands, m)
     named neither the goal nor an area holding it, given the goal there: ``1 - named_prob`` where the cell's
     shortest route from ``start_xy`` (m; over the robot's map, unseen space open) passes within ``junction_m``
-    of a reader and ends beyond it, 1 elsewhere; scaled to a peak of 1; None with no reader.
+    of a reader and ends beyond it, 1 elsewhere (a reader that near the start says nothing); scaled to a peak of
+    1; None with no reader.
 
     Signs name the places whose routes pass them, so a sign that does not name the goal says the goal lies off
     the ways it stands on."""
@@ -194,6 +195,8 @@ def passed_likelihood(grid: OccupancyGrid, readers: Iterable[tuple[float, float]
     total = np.ones(blocked.shape)
     for reader in readers:
         near = (np.hypot(xs - reader[0], ys - reader[1]) <= params.junction_m).ravel() & np.isfinite(lengths.ravel())
+        if near[start[0] * blocked.shape[1] + start[1]]:
+            continue  # every route from the start passes a sign beside it: not naming the goal says nothing
         through = near[follow_pointers(np.where(near, np.arange(near.size), pred))].reshape(blocked.shape)
         total *= np.where(through & ~near.reshape(blocked.shape), 1.0 - params.named_prob, 1.0)
     fine = unpool_cells(total, pool, grid.shape)

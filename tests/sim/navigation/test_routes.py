@@ -158,6 +158,8 @@ def test_a_sign_not_naming_the_goal_discounts_what_lies_beyond_it_on_the_way_fro
     assert at(grid, likelihood, 9.0, 11.5) == pytest.approx(1.0)  # the route passes about 4 m off
     assert at(grid, likelihood, 5.0, 6.0) == pytest.approx(1.0)  # before it
     assert passed_likelihood(grid, [], np.array([2.0, 6.0])) is None
+    beside_the_start = passed_likelihood(grid, [(3.0, 6.0)], np.array([2.0, 6.0]), params)
+    assert float(beside_the_start.min()) == pytest.approx(1.0)  # every route passes it: it says nothing
 
 
 def test_a_sign_not_naming_the_goal_says_nothing_of_a_branch_the_route_leaves_before_it():
