@@ -24,7 +24,7 @@ import numpy as np
 from scipy import ndimage
 
 from sim.mapping.occupancy import OccupancyGrid, pool_cells, unpool_cells
-from sim.navigation.routes import PathSearches, RouteParams, follow_pointers, open_cell
+from sim.navigation.routes import PathSearches, RouteParams, follow_pointers, open_cell, route_cells
 
 WALL_CELLS = 1e4  # route cost of a wall cell, in open cells: more than any route through open space
 
@@ -48,13 +48,12 @@ def frontier_values(grid: OccupancyGrid, mass: np.ndarray, looked: np.ndarray, r
     """Per cell of ``grid``, the belief mass ``V`` (same units as ``mass``) whose route from ``robot_xy`` (m)
     enters space not yet ``looked`` at within ``gather_m`` of that cell.
 
-    ``mass`` and ``looked`` have the grid's shape. Mass the robot cannot reach over its map (cut off, or inside
-    a wall with no open neighbour) is in no frontier's value.
+    ``mass`` and ``looked`` have the grid's shape. Mass the robot cannot reach over its map (cut off, beyond a
+    wall, or deeper in one than three route cells) is in no frontier's value.
     """
     routes = RouteParams() if routes is None else routes
-    pool = max(1, round(routes.cell_m / grid.resolution))
+    pool, blocked = route_cells(grid, routes)
     step = pool * grid.resolution
-    blocked = pool_cells(grid.occupied_mask(), pool, False, np.any)
     coarse = pool_cells(np.asarray(mass, dtype=float), pool, 0.0, np.sum)
     unlooked = pool_cells(looked.astype(np.float32), pool, np.float32(0.0), np.mean) < params.looked_share
     start = open_cell(grid, pool, blocked, np.asarray(robot_xy, dtype=float))

@@ -284,9 +284,10 @@ class FrontierSearch:
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float, rng: np.random.Generator,
                 value: Callable[[np.ndarray], np.ndarray | None] = lambda covered: None,
-                offset_m: float = 0.0) -> tuple[float, float]:
+                offset_m: float = 0.0, floor: float = 1e-6) -> tuple[float, float]:
         """The wheel command (m/s, rad/s) towards the frontier of least path length, or with ``value(covered)``
-        (per grid cell, given the cells looked at; None: path alone) of least ``(path + offset_m) / value``."""
+        (per grid cell, given the cells looked at; None: path alone) of least ``(path + offset_m) / value``
+        (a value below ``floor`` times the best counting as that)."""
         radius = self.params.planner.robot_radius_m
         covered = self.looked.update(grid, np.array(pose[:2]), self.frontier)
         if self.target is not None and t_s - self.checked_at >= self.frontier.recheck_s:
@@ -295,7 +296,7 @@ class FrontierSearch:
                 self.target = None
         if self.target is None or t_s - self.chosen_at >= self.rechoose_s:
             self.target = nearest_frontier(grid, np.array(pose[:2]), radius, self.frontier, self.visited, covered,
-                                           value=value(covered), offset_m=offset_m)
+                                           value=value(covered), offset_m=offset_m, floor=floor)
             self.chosen_at = self.checked_at = t_s
             self.drive.replanner.request()
             if self.target is None:
@@ -465,7 +466,7 @@ class GuidedPolicy(AbstractMapPolicy):
         self.now = t_s
         robot_xy = np.array(pose[:2])
         v, w = self.search.command(t_s, pose, grid, tick_s, rng, value=lambda covered: self._values(
-            grid, covered, robot_xy), offset_m=self.params.guide.offset_m)
+            grid, covered, robot_xy), offset_m=self.params.guide.offset_m, floor=self.params.guide.floor)
         if self.search.exhausted:
             self.gave_up = NO_FRONTIER
         return v, w

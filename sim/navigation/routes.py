@@ -123,6 +123,13 @@ class PathSearches:
         return lengths, self.parents[kind, start]
 
 
+def route_cells(grid: OccupancyGrid, params: RouteParams) -> tuple[int, np.ndarray]:
+    """The route cells: how many grid cells a side each pools (``cell_m``), and which are blocked (any mapped
+    obstacle in it)."""
+    pool = max(1, round(params.cell_m / grid.resolution))
+    return pool, pool_cells(grid.occupied_mask(), pool, False, np.any)
+
+
 def open_cell(grid: OccupancyGrid, pool: int, blocked: np.ndarray, xy: np.ndarray) -> tuple[int, int] | None:
     """The open cell of ``blocked`` (``grid``'s cells pooled ``pool`` x ``pool``) nearest to ``xy`` (m), or None
     when it has none."""
@@ -144,8 +151,7 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
     arrows = list(arrows)
     if not arrows:
         return None
-    pool = max(1, round(params.cell_m / grid.resolution))
-    blocked = pool_cells(grid.occupied_mask(), pool, False, np.any)  # any mapped obstacle blocks a coarse cell
+    pool, blocked = route_cells(grid, params)
     costs = np.where(blocked, np.inf, 1.0)
     step = pool * grid.resolution
     total = np.ones(blocked.shape)
@@ -183,8 +189,7 @@ def passed_likelihood(grid: OccupancyGrid, readers: Iterable[tuple[float, float]
     readers = [np.asarray(r, dtype=float) for r in readers]
     if not readers:
         return None
-    pool = max(1, round(params.cell_m / grid.resolution))
-    blocked = pool_cells(grid.occupied_mask(), pool, False, np.any)
+    pool, blocked = route_cells(grid, params)
     start = open_cell(grid, pool, blocked, np.asarray(start_xy, dtype=float))
     if start is None:
         return None
