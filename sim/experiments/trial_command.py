@@ -12,7 +12,7 @@ DIR/result.json (goal, success, reason, distance_m, simulated and wall seconds,
 cues read in order with the distance at each, the trajectory) and
 DIR/trajectory.png (floor plan, path, tags read, final imagined places).
 --record also writes DIR/run.gif, an animation of the robot, the explored map
-and the abstract map (with --navigator viewpoint also the goal belief, magenta,
+and the abstract map (with --navigator viewpoint or guided also the goal belief, magenta,
 and the swept space, blue). --log FILE.rrd writes a rerun recording on the
 simulated-time line (needs the [viz] extra). Exit code 0 when the goal was found, 1 when the trial
 failed (the reason is in result.json), 2 on bad input.

@@ -34,7 +34,7 @@ import numpy as np
 from abstract_map.clauses import Locational
 from abstract_map.model import SettleReport, imagined_positions
 from sim.mapping.occupancy import OccupancyGrid
-from sim.navigation.belief import Belief, BeliefParams, SweptSpace, cue_mass, goal_belief, goal_sigma
+from sim.navigation.belief import Belief, BeliefParams, GoalPrior, SweptSpace, cue_mass, goal_belief, goal_sigma
 from sim.navigation.follower import FollowerParams, PathFollower, Recovery, RecoveryParams, StuckDetector, StuckParams
 from sim.navigation.frontier import FrontierParams, LookedAt, nearest_frontier, still_frontier
 from sim.navigation.gateways import GuideParams, frontier_values
@@ -164,12 +164,27 @@ class AbstractMapPolicy:
     def settles(self) -> list[SettleReport]:
         return self.nav.settles
 
-    def goal_prior(self) -> tuple[np.ndarray, float]:
-        """The goal's imagined position (m; off the map too: a prior's near edge then lies on it) and the spread
-        (m) the model earns there (:func:`sim.navigation.belief.goal_sigma`)."""
+    def goal_prior(self) -> GoalPrior:
+        """The goal's imagined position (m; off the map too: a prior's near edge then lies on it), the spread
+        (m) the model earns there (:func:`sim.navigation.belief.goal_sigma`) and the labels read of its
+        siblings (:meth:`family_labels`)."""
         goal = self.nav.model.goal_estimate()
         anchors = np.array([f.xy for f in self.nav.model.fixed.values()])
-        return goal, goal_sigma(goal, anchors, self.params.belief, self.nav.misses_m)
+        return GoalPrior(goal, goal_sigma(goal, anchors, self.params.belief, self.nav.misses_m),
+                         self.family_labels())
+
+    def family_labels(self) -> np.ndarray:
+        """(K, 2) m: where the labels read of the goal's siblings hang (places with the goal's parent area,
+        the goal excluded); none when the goal has no parent or its parent is the hierarchy's root (the
+        whole building is no area)."""
+        model = self.nav.model
+        parent = model.hierarchy.parent.get(self.nav.goal)
+        if parent is None or parent not in model.hierarchy.parent:
+            return np.zeros((0, 2))
+        out = [model.fixed[anchor].xy for anchor, clauses in model.cue_clauses.items() for c in clauses
+               if isinstance(c, Locational) and c.kind == "label"
+               and (name := model.canonical(c.toponym)) != self.nav.goal and model.hierarchy.parent.get(name) == parent]
+        return np.array(out, dtype=float).reshape(-1, 2)
 
     def _areas(self) -> set[str]:
         """The places that hold the goal, up the hierarchy."""
@@ -383,8 +398,7 @@ class ViewpointPolicy(AbstractMapPolicy):
 
     def _goal_belief(self, grid: OccupancyGrid, robot_xy: np.ndarray) -> Belief:
         assert self.swept is not None
-        goal, sigma = self.goal_prior()
-        return goal_belief(grid, self.swept.swept, goal, sigma, self.params.belief, self._evidence(grid))
+        return goal_belief(grid, self.swept.swept, self.goal_prior(), self.params.belief, self._evidence(grid))
 
     def _retarget(self, t_s: float, robot_xy: np.ndarray, grid: OccupancyGrid) -> None:
         """Choose the viewpoint reading the most belief per metre; grow the model while the belief is used up."""
@@ -435,8 +449,9 @@ class GuidedPolicy(AbstractMapPolicy):
 
     The belief over where the goal's label hangs is the viewpoint policy's
     (:func:`sim.navigation.belief.goal_belief`): the abstract map's imagined goal
-    as a prior, as wide as the model's own misses in this building, times every
-    arrow read that names the goal or an area holding it
+    as a prior, as wide as the model's own misses in this building, mixed with
+    the labels read of the goal's siblings (:meth:`family_labels`) as the model
+    is trusted less, times every arrow read that names the goal or an area holding it
     and the doorways between the start and each place
     (:mod:`sim.navigation.routes`), on mapped walls more than in unseen space,
     and little where the robot has already looked. Each frontier is worth the
@@ -457,8 +472,7 @@ class GuidedPolicy(AbstractMapPolicy):
 
     def _values(self, grid: OccupancyGrid, covered: np.ndarray, robot_xy: np.ndarray) -> np.ndarray:
         """Per grid cell, the goal belief behind it (:func:`sim.navigation.gateways.frontier_values`)."""
-        goal, sigma = self.goal_prior()
-        self.belief = goal_belief(grid, covered, goal, sigma, self.params.belief, self._evidence(grid))
+        self.belief = goal_belief(grid, covered, self.goal_prior(), self.params.belief, self._evidence(grid))
         return frontier_values(grid, self.belief.mass, covered, robot_xy, self.params.guide, self.params.routes)
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,

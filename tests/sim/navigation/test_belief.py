@@ -6,7 +6,16 @@ import numpy as np
 import pytest
 
 from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
-from sim.navigation.belief import BeliefParams, SweptSpace, cue_mass, goal_belief, goal_sigma, sight_clear
+from sim.navigation.belief import (
+    BeliefParams,
+    GoalPrior,
+    SweptSpace,
+    cue_mass,
+    goal_belief,
+    goal_sigma,
+    prior_components,
+    sight_clear,
+)
 
 WALL_X = 6.0  # m, a mapped wall's west face
 
@@ -49,12 +58,12 @@ def test_walls_block_the_sight_line():
 def test_swept_cells_lose_their_belief_and_the_rest_renormalises():
     grid, params = corridor(), BeliefParams()
     swept = np.zeros(grid.shape, dtype=bool)
-    before = goal_belief(grid, swept, np.array([7.0, 4.0]), 2.0, params)
+    before = goal_belief(grid, swept, GoalPrior(np.array([7.0, 4.0]), 2.0), params)
     assert before.mass.sum() == pytest.approx(1.0, rel=1e-5)
     assert before.mass[grid.free_mask()].sum() == 0.0  # labels hang on walls, never in mapped free space
     space = SweptSpace(grid, params)
     space.sweep(grid, (WALL_X - 2.0, 4.0))
-    after = goal_belief(grid, space.swept, np.array([7.0, 4.0]), 2.0, params)
+    after = goal_belief(grid, space.swept, GoalPrior(np.array([7.0, 4.0]), 2.0), params)
     assert after.mass.sum() == pytest.approx(1.0, rel=1e-5)
     ratio = after.mass[space.swept].sum() / before.mass[space.swept].sum()
     rest = after.mass[~space.swept].sum() / before.mass[~space.swept].sum()
@@ -88,3 +97,37 @@ def test_cue_mass_is_unswept_wall_near_the_robot():
     assert mass[grid.free_mask()].sum() == 0.0
     far = grid.world_to_cell(np.array([[9.5, 0.5]]))[0]
     assert mass[far[0], far[1]] == 0.0
+
+
+def test_prior_without_siblings_is_the_imagined_goal():
+    prior = GoalPrior(np.array([3.0, 4.0]), 5.0)
+    [(weight, centre, spread)] = prior_components(prior, BeliefParams())
+    assert weight == 1.0 and spread == 5.0 and centre.tolist() == [3.0, 4.0]
+
+
+def test_each_estimate_counts_by_its_precision():
+    """Spread 20 m against the family's 6.5 m: the siblings share 90% of the prior, each at its own label."""
+    params = BeliefParams()
+    sf = params.family_sigma_m
+    comps = prior_components(GoalPrior(np.array([0.0, 0.0]), 20.0, np.array([[30.0, 0.0], [0.0, 40.0]])), params)
+    (own, centre, spread), *family = comps
+    assert own == pytest.approx(sf ** 2 / (400.0 + sf ** 2)) and own < 0.1
+    assert centre.tolist() == [0.0, 0.0] and spread == 20.0
+    assert [w for w, _, _ in family] == pytest.approx([(1 - own) / 2] * 2)
+    assert [c.tolist() for _, c, _ in family] == [[30.0, 0.0], [0.0, 40.0]]
+    assert all(s == sf for _, _, s in family)
+    sharp = prior_components(GoalPrior(np.array([0.0, 0.0]), 2.0, np.array([[30.0, 0.0]])), params)
+    assert sharp[0][0] > 0.9  # a model trusted to 2 m keeps its own estimate
+
+
+def test_belief_moves_to_where_siblings_were_read():
+    """The model imagines the goal at the wall's south end; a sibling's label read at its north end draws the
+    belief north when the model is not trusted."""
+    grid, params = corridor(), BeliefParams()
+    swept = np.zeros(grid.shape, dtype=bool)
+    alone = goal_belief(grid, swept, GoalPrior(np.array([7.0, 0.0]), 10.0), params)
+    family = goal_belief(grid, swept, GoalPrior(np.array([7.0, 0.0]), 10.0, np.array([[7.0, 8.0]])), params)
+    top = wall_cells_at(grid, 7.0)
+    bottom = wall_cells_at(grid, 1.0)
+    assert family.mass[top].sum() > alone.mass[top].sum()
+    assert family.mass[bottom].sum() < alone.mass[bottom].sum()

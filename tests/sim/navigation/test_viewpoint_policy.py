@@ -48,3 +48,29 @@ def test_viewpoint_finds_every_goal_of_a_generated_building(tmp_path, style):
         result = run_trial(world, goal, perception="geometric", navigator="viewpoint")
         assert result.success, (goal, result.reason)
 
+
+
+def test_family_labels_are_the_goals_siblings_read(tmp_path):
+    """The guided prior's family: labels read of places sharing the goal's parent area, nothing else."""
+    import numpy as np
+
+    from sim.experiments.trial import TrialParams, policy_params
+    from sim.navigation.policies import GuidedPolicy
+    from sim.world.data import load_world
+    from sim.world.generator import generated_world
+
+    world = load_world(generated_world(0, style="office", size="medium", signage="complete", root=tmp_path))
+    labels = [t for t in world.tags.values() if t.kind == "label"]
+    parent = GuidedPolicy(world, sorted(world.goals)[0], world.start, policy_params(TrialParams())
+                          ).nav.model.hierarchy.parent
+    goal = max(sorted(world.goals), key=lambda g: sum(parent.get(t.text) == parent[g] for t in labels))
+    policy = GuidedPolicy(world, goal, world.start, policy_params(TrialParams()))
+    siblings = [t for t in labels if t.text != goal and parent.get(t.text) == parent[goal]]
+    others = [t for t in labels if t.text != goal and parent.get(t.text) != parent[goal]]
+    assert len(siblings) >= 2 and others and parent[goal] in parent  # the goal's area lies inside the building
+    assert policy.family_labels().shape == (0, 2)
+    for tag in [*siblings, others[0], world.tags[world.goals[goal]]]:
+        policy.nav.model.observe_tag(tag.id, tag.text, (tag.x, tag.y, tag.theta))
+    read = policy.family_labels()
+    assert sorted(map(tuple, read.round(3))) == sorted((round(t.x, 3), round(t.y, 3)) for t in siblings)
+    assert np.isfinite(read).all()

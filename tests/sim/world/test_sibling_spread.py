@@ -1,0 +1,24 @@
+"""``scripts/sibling_spread.py``: the measurement behind ``BeliefParams.family_sigma_m``."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+SCRIPT = Path(__file__).resolve().parents[3] / "scripts" / "sibling_spread.py"
+
+
+def load():
+    spec = importlib.util.spec_from_file_location("sibling_spread", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_sibling_labels_hang_within_the_building_and_apart(capsys):
+    script = load()
+    distances = script.sibling_distances(0, "office")
+    assert len(distances) > 20
+    assert 0.0 < min(distances) and max(distances) < 60.0  # a medium building is about 45 m across
+    assert script.main(["0", "0"]) == 0
+    assert "per-axis rms" in capsys.readouterr().out
