@@ -11,10 +11,11 @@ Two grids over the robot's occupancy grid (same cells, world frame, metres):
 - :func:`goal_belief`: a distribution over the cell holding the goal's label.
   Its prior is the abstract map's: a Gaussian about the goal's imagined
   position, its spread growing with how far that position is extrapolated from
-  anything observed, narrowed towards the labels of the goal's siblings read
-  so far (places of one area hang together). Labels hang on walls, so a cell's prior is weighted by the
-  chance it is wall (1 mapped wall, 0 mapped free, ``unknown_wall_prob``
-  unseen); swept cells are multiplied by the chance a label there was missed.
+  anything observed, mixed with Gaussians about the labels read of the goal's
+  siblings (places of one area hang together). Labels hang on walls, so a
+  cell's prior is weighted by the chance it is wall (1 mapped wall, 0 mapped
+  free, ``unknown_wall_prob`` unseen); swept cells are multiplied by the chance
+  a label there was missed.
 
 See ``docs/method-notes.md`` (negative information) for the equations.
 """
@@ -50,10 +51,10 @@ class BeliefParams:
     prior_misses: float = 3.0  # how many of the model's misses (below) the spread from ``sigma_min_m`` and
     # ``sigma_per_m`` counts as: a few labels read decide how far the model is trusted in this building
     tail_weight: float = 0.3  # share of the prior in a wide tail: the model may be wrong (a sign misread, a guess)
+    tail_scale: float = 3.0  # the tail's spread, in multiples of sigma
     family_sigma_m: float = 6.5  # m, spread of a place's label about a sibling's (same parent area) label: the
     # per-axis rms of sibling label distances on development buildings 0-99 is 6.6-6.8 m
     # (scripts/sibling_spread.py)
-    tail_scale: float = 3.0  # the tail's spread, in multiples of sigma
 
 
 @dataclass(frozen=True)
@@ -253,8 +254,8 @@ def goal_belief(grid: OccupancyGrid, swept: np.ndarray, prior: GoalPrior, params
                 evidence: np.ndarray | None = None) -> Belief:
     """Posterior over the label's cell: prior x evidence x wall chance x (1 - detect_prob on swept cells).
 
-    The prior is :func:`prior_components` (the imagined goal, narrowed towards
-    its siblings' labels) mixed with a wide tail about the imagined goal
+    The prior is :func:`prior_components` (the imagined goal mixed with its
+    siblings' labels) mixed with a wide tail about the imagined goal
     (``tail_weight``, ``tail_scale`` times its spread). ``evidence`` (the grid's
     shape, e.g. :func:`sim.navigation.routes.route_likelihood` of the arrows
     read) multiplies it.
