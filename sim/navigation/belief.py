@@ -214,7 +214,7 @@ def prior_components(prior: GoalPrior, params: BeliefParams) -> list[tuple[float
     metres in this building hands it to the area where the siblings were read. A mixture, not a product:
     either may be wrong by more than its spread says (the model's misses are heavy-tailed)."""
     centre, sigma = np.asarray(prior.centre, dtype=float), float(prior.sigma_m)
-    family = np.atleast_2d(np.asarray(prior.family_xy, dtype=float)).reshape(-1, 2)
+    family = np.asarray(prior.family_xy, dtype=float).reshape(-1, 2)
     if len(family) == 0:
         return [(1.0, centre, sigma)]
     sf2, s2 = params.family_sigma_m ** 2, sigma ** 2

@@ -177,13 +177,18 @@ class AbstractMapPolicy:
         """(K, 2) m: where the labels read of the goal's siblings hang (places with the goal's parent area,
         the goal excluded); none when the goal has no parent or its parent is the hierarchy's root (the
         whole building is no area)."""
-        model = self.nav.model
-        parent = model.hierarchy.parent.get(self.nav.goal)
-        if parent is None or parent not in model.hierarchy.parent:
+        model, parents = self.nav.model, self.nav.model.hierarchy.parent
+        area = parents.get(self.nav.goal)
+        if area is None or area not in parents:
             return np.zeros((0, 2))
-        out = [model.fixed[anchor].xy for anchor, clauses in model.cue_clauses.items() for c in clauses
-               if isinstance(c, Locational) and c.kind == "label"
-               and (name := model.canonical(c.toponym)) != self.nav.goal and model.hierarchy.parent.get(name) == parent]
+        out = []
+        for anchor, clauses in model.cue_clauses.items():
+            for c in clauses:
+                if not (isinstance(c, Locational) and c.kind == "label"):
+                    continue
+                name = model.canonical(c.toponym)
+                if name != self.nav.goal and parents.get(name) == area:
+                    out.append(model.fixed[anchor].xy)
         return np.array(out, dtype=float).reshape(-1, 2)
 
     def _areas(self) -> set[str]:

@@ -49,11 +49,11 @@ def test_viewpoint_finds_every_goal_of_a_generated_building(tmp_path, style):
         assert result.success, (goal, result.reason)
 
 
-
 def test_family_labels_are_the_goals_siblings_read(tmp_path):
     """The guided prior's family: labels read of places sharing the goal's parent area, nothing else."""
     import numpy as np
 
+    from abstract_map.hierarchy import Hierarchy
     from sim.experiments.trial import TrialParams, policy_params
     from sim.navigation.policies import GuidedPolicy
     from sim.world.data import load_world
@@ -61,8 +61,7 @@ def test_family_labels_are_the_goals_siblings_read(tmp_path):
 
     world = load_world(generated_world(0, style="office", size="medium", signage="complete", root=tmp_path))
     labels = [t for t in world.tags.values() if t.kind == "label"]
-    parent = GuidedPolicy(world, sorted(world.goals)[0], world.start, policy_params(TrialParams())
-                          ).nav.model.hierarchy.parent
+    parent = Hierarchy.from_xml(world.hierarchy_path).parent
     goal = max(sorted(world.goals), key=lambda g: sum(parent.get(t.text) == parent[g] for t in labels))
     policy = GuidedPolicy(world, goal, world.start, policy_params(TrialParams()))
     siblings = [t for t in labels if t.text != goal and parent.get(t.text) == parent[goal]]
