@@ -67,26 +67,35 @@ class SpringIndex:
         self.touching: dict[str, dict[Resolved, None]] = {}
         self._between: dict[tuple[str, str], dict[Resolved, None]] = {}  # sorted ends -> distance springs
         self._lengths: dict[tuple[str, str], float | None] = {}  # sorted ends -> l, or None: no distance spring
+        self.changed_pairs: set[tuple[str, str]] = set()  # pairs whose distance springs changed (callers clear it)
         self.update(springs, ())
 
     def update(self, added: Iterable[Resolved], removed: Iterable[Resolved]) -> None:
         """Add and remove springs (each occurrence once)."""
+        count, touching, between, lengths, changed = (self.count, self.touching, self._between, self._lengths,
+                                                      self.changed_pairs)
         for s in removed:
-            self.count[s] -= 1
-            if self.count[s] <= 0:
-                del self.count[s]
-                for end in s.ends:
-                    self.touching[end].pop(s, None)
-                if s.kind == "distance":
-                    self._between[_pair(*s.ends)].pop(s, None)
-                    self._lengths.pop(_pair(*s.ends), None)
-        for s in added:
-            self.count[s] += 1
+            left = count[s] - 1
+            if left > 0:
+                count[s] = left
+                continue
+            dict.__delitem__(count, s)  # Counter's own __delitem__ is Python, and the key is known to be there
             for end in s.ends:
-                self.touching.setdefault(end, {})[s] = None
+                touching[end].pop(s, None)
             if s.kind == "distance":
-                self._between.setdefault(_pair(*s.ends), {})[s] = None
-                self._lengths.pop(_pair(*s.ends), None)
+                ends = pair(*s.ends)
+                between[ends].pop(s, None)
+                lengths.pop(ends, None)
+                changed.add(ends)
+        for s in added:
+            count[s] += 1
+            for end in s.ends:
+                touching.setdefault(end, {})[s] = None
+            if s.kind == "distance":
+                ends = pair(*s.ends)
+                between.setdefault(ends, {})[s] = None
+                lengths.pop(ends, None)
+                changed.add(ends)
 
     def around(self, names: Iterable[str]) -> list[Resolved]:
         """Every spring touching one of ``names``, once each."""
@@ -98,16 +107,16 @@ class SpringIndex:
     def length(self, spring: Resolved, default: float) -> float:
         """``l`` (m) of an angle spring: the natural length of the stiffest distance spring between its pivot
         and the place it turns (global: reference and figure; relative: vertex and its second place)."""
-        pair = _pair(*spring.ends[-2:])  # pivot and turned place
-        if pair not in self._lengths:
+        ends = pair(*spring.ends[-2:])  # pivot and turned place
+        if ends not in self._lengths:
             # the stiffest; of equals, the first in field order (not the order the index met them in)
-            best = min(self._between.get(pair, {}), key=lambda s: (-s.stiffness, s.fields), default=None)
-            self._lengths[pair] = None if best is None else best.value
-        length = self._lengths[pair]
+            best = min(self._between.get(ends, {}), key=lambda s: (-s.stiffness, s.fields), default=None)
+            self._lengths[ends] = None if best is None else best.value
+        length = self._lengths[ends]
         return default if length is None else length
 
 
-def _pair(a: str, b: str) -> tuple[str, str]:
+def pair(a: str, b: str) -> tuple[str, str]:
     """Two names in a fixed order: the key of the springs between them."""
     return (a, b) if a <= b else (b, a)
 

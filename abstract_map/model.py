@@ -13,10 +13,12 @@ import dataclasses
 import math
 import time
 from collections import Counter
-from collections.abc import Callable, Hashable, Iterable, Mapping
+from collections.abc import Callable, Collection, Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import partial
-from typing import Any
+from itertools import compress, islice
+from operator import is_not
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -85,19 +87,45 @@ class _Mentions:
 class _LastSettle:
     """What a settle left for the next to compare with."""
 
-    springs: set[Resolved]
+    springs: list[Resolved]  # the model's resolved springs, in its order
+    members: set[Resolved]  # the same as a set (handed from settle to settle, changed only where springs did)
     count: Counter[Resolved]  # each spring's occurrences, kept only when some spring occurs twice
     duplicates: int  # occurrences beyond the first, all springs together
-    fixed: dict[str, np.ndarray]  # m, every fixed point
+    fixed: dict[str, tuple[float, float]]  # m, every fixed point
     moving: list[str]  # places left with |v| >= L_v (by a cap)
 
     @classmethod
-    def of(cls, springs: list[Resolved], fixed: dict[str, np.ndarray], moving: list[str],
-           current: set[Resolved] | None = None) -> _LastSettle:
-        """``current``: ``set(springs)`` when already at hand."""
-        current = set(springs) if current is None else current
-        duplicates = len(springs) - len(current)
-        return cls(current, Counter(springs) if duplicates else Counter(), duplicates, fixed, moving)
+    def of(cls, springs: list[Resolved], fixed: Mapping[str, FixedPoint], moving: list[str],
+           members: set[Resolved] | None = None) -> _LastSettle:
+        """``members``: ``set(springs)`` when already at hand."""
+        members = set(springs) if members is None else members
+        duplicates = len(springs) - len(members)
+        return cls(springs, members, Counter(springs) if duplicates else Counter(), duplicates,
+                   {n: (f.x, f.y) for n, f in fixed.items()}, moving)
+
+
+class _Disturbance(NamedTuple):
+    """What a settle starts from: the places it moves, those it tests first, and the springs as a set."""
+
+    active: list[str]
+    tested: list[str]
+    members: set[Resolved]
+
+
+def spring_changes(old: Sequence[Resolved], new: Sequence[Resolved],
+                   members: Collection[Resolved]) -> tuple[list[Resolved], list[Resolved]] | None:
+    """The springs ``new`` adds to ``old`` and those it removes, comparing position by position (a model's
+    springs mostly keep their places from settle to settle), or None if ``new`` holds some spring twice.
+    ``old`` must hold each spring once; ``members`` is ``set(old)``. Costs time in proportion to the
+    positions that differ, not to the springs."""
+    n = min(len(old), len(new))
+    differ = list(compress(range(n), map(is_not, islice(new, n), islice(old, n))))
+    fresh = dict.fromkeys([new[i] for i in differ] + list(new[n:]))
+    gone = dict.fromkeys([old[i] for i in differ] + list(old[n:]))
+    added = [s for s in fresh if s not in gone]
+    if len(fresh) < len(differ) + len(new) - n or any(s in members for s in added):
+        return None  # a spring twice: at two of the positions that differ, or also at one that does not
+    return added, [s for s in gone if s not in fresh]
 
 
 @dataclass(frozen=True)
@@ -467,32 +495,36 @@ class AbstractMap:
             return
         self.explored_centre = np.array(errors.point("explored centre", xy, error=ModelError))
 
-    def _disturbed(self, springs: list[Resolved], current: set[Resolved], new: list[str],
-                   fixed: Mapping[str, np.ndarray]) -> tuple[list[str], list[str]]:
-        """Bring the spring index up to date; the places a settle starts from, and those it tests first.
+    def _disturbed(self, springs: list[Resolved], new: list[str], fixed: Mapping[str, FixedPoint]) -> _Disturbance:
+        """Bring the spring index up to date, and say what a settle starts from (before new places are placed).
 
         The first settle moves every place. After it: the new places and those a capped settle left moving
         (|v| >= L_v) move; the ends of springs added, removed or changed, and of springs to fixed points that
         moved, since the last settle are tested, and move if they fail Algorithm 1's acceleration test."""
         last = self._last_settle
-        if last is None or len(springs) - len(current) or last.duplicates:  # a spring twice: count them all
+        changes = None if last is None or last.duplicates else spring_changes(last.springs, springs, last.members)
+        if changes is None:  # the first settle, or a spring twice: count them all
+            members = set(springs)
             self._index = SpringIndex(springs)
             if last is None:
-                return [p for p in self.places() if p in self.positions], []
+                return _Disturbance(self.places(), [], members)
             changed: Iterable[Resolved] = sorted((Counter(springs) - last.count) + (last.count - Counter(springs)),
                                                  key=FIELDS)
         else:
-            added, removed = current - last.springs, last.springs - current
+            added, removed = changes
             self._index.update(added, removed)
-            changed = sorted([*added, *removed], key=FIELDS)  # sets: put in an order no hash decides
+            members = last.members
+            members.difference_update(removed)
+            members.update(added)
+            changed = sorted([*added, *removed], key=FIELDS)  # put in an order no hash decides
         tested: dict[str, None] = {}
         for spring in changed:
             tested.update(dict.fromkeys(spring.ends))
-        for name, xy in fixed.items():
-            if name not in last.fixed or not np.array_equal(last.fixed[name], xy):
+        for name, point in fixed.items():
+            if last.fixed.get(name) != (point.x, point.y):
                 for spring in self._index.around([name]):
                     tested.update(dict.fromkeys(spring.ends))
-        return [*new, *last.moving], [p for p in tested if p in self.positions]
+        return _Disturbance([*new, *last.moving], list(tested), members)
 
     def as_last_settled(self) -> list[str] | None:
         """If nothing has changed since the last settle, the places it left moving (|v| >= L_v); else None.
@@ -503,10 +535,8 @@ class AbstractMap:
         if last is None:
             return None
         springs = self.resolved_springs()
-        fixed = {n: f.xy for n, f in self.fixed.items()}
-        same = (set(springs) == last.springs and len(springs) - len(last.springs) == last.duplicates
-                and fixed.keys() == last.fixed.keys()
-                and all(np.array_equal(xy, last.fixed[n]) for n, xy in fixed.items())
+        same = (set(springs) == last.members and len(springs) - len(last.members) == last.duplicates
+                and {n: (f.x, f.y) for n, f in self.fixed.items()} == last.fixed
                 and set(self.places()) <= set(self.positions))
         return list(last.moving) if same else None
 
@@ -514,8 +544,7 @@ class AbstractMap:
         """Take the model as its last settle left it, with ``moving`` still moving (see :meth:`as_last_settled`)."""
         springs = self.resolved_springs()
         self._index = SpringIndex(springs)
-        self._last_settle = _LastSettle.of(springs, {n: f.xy for n, f in self.fixed.items()},
-                                           [p for p in moving if p in self.positions])
+        self._last_settle = _LastSettle.of(springs, self.fixed, [p for p in moving if p in self.positions])
 
     def settle(self, *, max_steps: int | None = None, max_s: float | None = None) -> SettleReport:
         """Place new masses (Algorithm 2), then integrate until settled (Algorithm 1) or a cap is hit.
@@ -526,9 +555,10 @@ class AbstractMap:
         settle carries on from there."""
         max_steps, max_s = settle_caps(max_steps, max_s)
         began = time.perf_counter()
-        springs = self.resolved_springs()
+        springs = self._cached("resolved", self._resolved_springs, self.exploration_factor)  # shared: not changed
         places = self.places()
         new = [p for p in places if p not in self.positions]
+        disturbed = self._disturbed(springs, new, self.fixed)
         placed: dict[str, np.ndarray] = {}
         if new:  # Algorithm 2 needs only the springs touching a new mass
             known = {**{n: f.xy for n, f in self.fixed.items()}, **self.positions}
@@ -544,14 +574,16 @@ class AbstractMap:
         expand = set(places) if self.params.dynamics.expansion_on == "all" else \
             {p for p in places if p not in parents}
         fixed = {n: f.xy for n, f in self.fixed.items()}
-        current = set(springs)
-        active, tested = self._disturbed(springs, current, new, fixed)
-        self._field.prepare(self._cached("clause springs", self._springs_of_clauses), springs,
-                            partial(self._index.length, default=self.params.dynamics.angle_length))
-        result = run_dynamics(self.positions, self.velocities, fixed, self._index, active=active, tested=tested,
-                              field=self._field, expand=expand, centre=self.explored_centre,
-                              params=self.params.dynamics, max_steps=max_steps,
-                              deadline=None if max_s is None else began + max_s)
+        try:
+            self._field.prepare(self._cached("clause springs", self._springs_of_clauses), springs, self._index,
+                                self.params.dynamics.angle_length, self._resolver.values_of(springs))
+            result = run_dynamics(self.positions, self.velocities, fixed, self._index, active=disturbed.active,
+                                  tested=[p for p in disturbed.tested if p in self.positions], field=self._field,
+                                  expand=expand, centre=self.explored_centre, params=self.params.dynamics,
+                                  max_steps=max_steps, deadline=None if max_s is None else began + max_s)
+        except BaseException:
+            self._last_settle = None  # the spring index already took this settle's changes: start afresh
+            raise
         bad = [n for n, xy in result.positions.items() if not np.all(np.abs(xy) <= errors.COORDINATE_LIMIT_M)]
         if bad:  # never expected with checked inputs: refuse rather than hand out NaN
             for name in placed:
@@ -563,8 +595,8 @@ class AbstractMap:
         self.positions.update(result.positions)
         self.velocities.update(result.velocities)
         limit = self.params.dynamics.settle_velocity
-        self._last_settle = _LastSettle.of(springs, fixed, [n for n, v in result.velocities.items()
-                                                            if float(np.hypot(*v)) >= limit], current)
+        self._last_settle = _LastSettle.of(springs, self.fixed, [n for n, v in result.velocities.items()
+                                                                 if float(np.hypot(*v)) >= limit], disturbed.members)
         return SettleReport(result.settled, result.iterations, time.perf_counter() - began, tuple(new),
                             result.stopped_by, len(result.positions))
 

@@ -18,14 +18,16 @@ Each gives exactly what its from-scratch counterpart (``springs_from_clauses``,
 from __future__ import annotations
 
 from array import array
-from collections.abc import Callable, Hashable, Iterable, Mapping, Sequence
+from collections.abc import Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from .clauses import Clause, is_anchor
+from .dynamics import SpringIndex, pair
 from .forces import ANGLE_KINDS, NetForce
 from .params import ScaleDefaults
 from .placement import Resolved
@@ -123,6 +125,7 @@ class Resolver:
         self._table: _Table | None = None
         self._values = np.zeros(0)
         self._out: list[Resolved] = []
+        self._returned: tuple[list[Resolved], np.ndarray] | None = None  # the last list returned, its values
 
     def _new_fold(self) -> GrowingFold[Spring, _Table]:
         return GrowingFold[Spring, _Table](_Table, self._take)
@@ -171,7 +174,16 @@ class Resolver:
         self._table, self._values, self._out = table, values, out
         ends = self._values_of(np.array(tail_keys, dtype=np.int64), np.array([s.value for s in tail], dtype=float),
                                np.array([s.scale == "label" for s in tail], dtype=np.int8), alpha, exploration)
-        return out + [_resolved(s, float(v)) for s, v in zip(tail, ends.tolist())]
+        returned = out + [_resolved(s, float(v)) for s, v in zip(tail, ends.tolist())]
+        self._returned = returned, np.concatenate([values, ends])
+        return returned
+
+    def values_of(self, resolved: list[Resolved]) -> np.ndarray | None:
+        """The natural values (m or rad) of ``resolved`` as an array, if it is the list the last call returned
+        (the same object); else None."""
+        if self._returned is None or self._returned[0] is not resolved:
+            return None
+        return self._returned[1]
 
     @staticmethod
     def _values_of(key: np.ndarray, unit: np.ndarray, label: np.ndarray, alpha: np.ndarray,
@@ -195,6 +207,7 @@ class _Structure:
     slots: array = field(default_factory=lambda: array("q"))  # 3 per spring (distance and global use 2)
     stiffness: array = field(default_factory=lambda: array("d"))
     incident: dict[int, list[int]] = field(default_factory=dict)  # slot -> the springs touching it
+    by_pair: dict[tuple[str, str], list[int]] = field(default_factory=dict)  # pivot and turned -> angle springs
     count: int = 0
 
     def take(self, springs: Sequence[Spring | Resolved]) -> None:
@@ -204,6 +217,8 @@ class _Structure:
             for end in ends:
                 self.incident.setdefault(end, []).append(self.count)
             self.kind.append(ANGLE_KINDS.get(s.kind, 0))
+            if s.kind in ANGLE_KINDS:
+                self.by_pair.setdefault(pair(*s.ends[-2:]), []).append(self.count)
             self.stiffness.append(s.stiffness)
             self.count += 1
 
@@ -220,12 +235,15 @@ class SpringField:
         self._names: list[str] = []
         self._parts: tuple[_Structure, _Structure] = (_Structure(), _Structure())
         self._arrays: tuple[np.ndarray, ...] = ()
+        self._lengths = np.zeros(0)  # the front springs' l (m; 0 for distance springs), as of the last prepare
+        self._lengths_of: Any = None  # the spring index those lengths came from
 
-    def prepare(self, front: Sequence[Spring], resolved: Sequence[Resolved],
-                length: Callable[[Resolved], float]) -> None:
+    def prepare(self, front: Sequence[Spring], resolved: Sequence[Resolved], index: SpringIndex, default: float,
+                values: np.ndarray | None = None) -> None:
         """``resolved``: the model's resolved springs, whose first ``len(front)`` are ``front`` resolved (the
-        springs that mostly grow at their end) and the rest a few made anew each time; ``length``: an angle
-        spring's ``l`` (m), as ``dynamics.SpringIndex.length`` gives it."""
+        springs that mostly grow at their end) and the rest a few made anew each time; ``index``: the same
+        springs by mass, which gives an angle spring's ``l`` (m; ``default`` when no distance spring joins
+        its pivot and the place it turns); ``values``: the springs' natural values, if at hand."""
         fixed = self._fold(front)
         tail = _Structure(slot=dict(fixed.slot), count=len(front))  # the tail's own arrays and slots
         tail.take(resolved[len(front):])
@@ -233,13 +251,22 @@ class SpringField:
         rows = np.concatenate([np.frombuffer(fixed.slots, dtype=np.int64),
                                np.frombuffer(tail.slots, dtype=np.int64)]).reshape(-1, 3)
         stiffness = np.concatenate([np.frombuffer(fixed.stiffness), np.frombuffer(tail.stiffness)])
-        value = np.array([s.value for s in resolved], dtype=float)
-        lengths = np.zeros(len(resolved))
-        for i in np.flatnonzero(kind).tolist():
-            lengths[i] = length(resolved[i])
+        value = np.array([s.value for s in resolved], dtype=float) if values is None else values
+        n = len(front)
+        if fixed is self._parts[0] and index is self._lengths_of:  # the same springs, grown: redo what changed
+            lengths = np.concatenate([self._lengths, np.zeros(n - len(self._lengths))])
+            redo = [i for p in index.changed_pairs for i in fixed.by_pair.get(p, ())]
+            redo += (np.flatnonzero(kind[len(self._lengths):n]) + len(self._lengths)).tolist()
+        else:
+            lengths, redo = np.zeros(n), np.flatnonzero(kind[:n]).tolist()
+        for i in redo:
+            lengths[i] = index.length(resolved[i], default)
+        index.changed_pairs.clear()
+        self._lengths, self._lengths_of = lengths, index
+        tail_lengths = [index.length(s, default) if s.kind in ANGLE_KINDS else 0.0 for s in resolved[n:]]
         self._parts = fixed, tail
         self._slot, self._names = tail.slot, list(tail.slot)
-        self._arrays = kind, rows, value, stiffness, lengths
+        self._arrays = kind, rows, value, stiffness, np.concatenate([lengths, tail_lengths])
 
     def around(self, names: Sequence[str], *, expand: Sequence[bool], centre: complex | None, expansion: float,
                law: str, core: float, share: float) -> NetForce:

@@ -12,7 +12,7 @@ from abstract_map.clauses import Relational
 from abstract_map.dynamics import ComplexPositions, SpringIndex
 from abstract_map.forces import forces_on
 from abstract_map.hierarchy import Hierarchy
-from abstract_map.model import AbstractMap
+from abstract_map.model import AbstractMap, spring_changes
 from abstract_map.placement import Resolved
 from abstract_map.resolution import LooseGroups, SpringField
 from abstract_map.scales import learn_scales, natural_lengths
@@ -107,8 +107,7 @@ def test_the_spring_field_gives_each_mass_the_net_force_its_own_springs_give():
                          expand=[False] * len(names), centre=None, expansion=0.0, law="constant",
                          core=params.angle_core, share=params.angle_core_share)
     field = SpringField()
-    field.prepare(model._cached("clause springs", model._springs_of_clauses), springs,
-                  lambda s: index.length(s, params.angle_length))
+    field.prepare(model._cached("clause springs", model._springs_of_clauses), springs, index, params.angle_length)
     net = field.around(names, expand=[False] * len(names), centre=None, expansion=0.0, law="constant",
                        core=params.angle_core, share=params.angle_core_share)
     got = net(np.array([where[n] for n in net.slots], dtype=complex))
@@ -120,3 +119,28 @@ def test_the_spring_field_gives_each_mass_the_net_force_its_own_springs_give():
     assert np.allclose(net(np.array([where[n] for n in net.slots], dtype=complex)), expected[::7], rtol=1e-9,
                        atol=1e-12)
 
+
+
+def test_spring_changes_finds_what_was_added_and_removed_position_by_position():
+    a, b, c, d = (Resolved("distance", (x, "Z"), 1.0, 0.1) for x in "abcd")
+    b2 = Resolved("distance", ("b", "Z"), 2.0, 0.1)  # b re-scaled
+    old = [a, b, c]
+    assert spring_changes(old, list(old), set(old)) == ([], [])
+    assert spring_changes(old, [a, b2, c, d], set(old)) == ([b2, d], [b])
+    assert spring_changes(old, [a, c], set(old)) == ([], [b])  # a spring gone: the rest move up a place
+    equal_copy = Resolved("distance", ("c", "Z"), 1.0, 0.1)  # made anew but equal: no change
+    assert spring_changes(old, [a, b, equal_copy], set(old)) == ([], [])
+    assert spring_changes(old, [a, b, c, a], set(old)) is None  # a spring twice
+    assert spring_changes(old, [a, b2, c, b2], set(old)) is None
+
+
+def test_the_spring_field_keeps_each_angle_springs_l_as_a_fresh_field_gives_it():
+    model, walk = walked(12, 150, settled=False)
+    for tag, text, pose in walk.cues[12:30]:  # labels among them re-scale signs' springs
+        model.observe_tag(tag, text, pose)
+        model.settle()
+        fresh = SpringField()
+        fresh.prepare(model._cached("clause springs", model._springs_of_clauses), model.resolved_springs(),
+                      SpringIndex(model.resolved_springs()), model.params.dynamics.angle_length)
+        assert np.array_equal(model._field._arrays[4], fresh._arrays[4])
+        assert np.array_equal(model._field._arrays[2], fresh._arrays[2])
