@@ -15,7 +15,7 @@ DIR/worlds/. Seeds 0-999 are for development; 1000-1999 are test buildings, for 
 
 Trials differ by seed: start-pose jitter (0.10 m, 3 deg), the recovery's turning direction and, in
 geometric mode, detection noise (0.03 m, 1 deg). Writes DIR/settings.json, DIR/trials/ (one JSON per
-trial), DIR/trials.csv (world, style, signage, navigator, goal, seed, perception, success, reason,
+trial), DIR/trials.csv (world, style, signage, navigator, goal, seed, perception, success, reason, explanation,
 distance_m, oracle_m, spl, sim_s, wall_s, cpu_s), DIR/report.md (success rate, SPL, ratio to the oracle and
 failures by reason: overall, per navigator, style, signage level and world; the ten worst trials with
 pictures in DIR/worst/) and, for the zoo, the paper's Table I extended, DIR/comparison.png (box plots

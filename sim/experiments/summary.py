@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from sim.experiments.diagnosis import KINDS
 from sim.experiments.pictures import draw_floorplan, draw_path, draw_tags
 from sim.world.data import World
 
@@ -30,6 +31,12 @@ def reason_kind(record: Record) -> str:
     if reason.startswith("error:"):
         return ":".join(reason.split(":")[:2]).strip()
     return re.sub(r"\d+(\.\d+)?", "N", reason.split(":")[0]).strip()
+
+
+def explanation_kind(record: Record) -> str:
+    """A failure's explanation without its particulars (a kind of ``sim.experiments.diagnosis.KINDS``); "-" for
+    a record made before trials were explained."""
+    return str(record.get("explanation") or "-").split(":")[0].strip()
 
 
 def stats(records: list[Record]) -> dict[str, Any]:
@@ -100,7 +107,8 @@ def trial_picture(record: Record, world: World, path: Path, oracle: np.ndarray |
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
     spl = record.get("spl")
-    ax.set_title(f"{world.name}: {record['goal']} (SPL {_f(spl)}; {record.get('reason', '')})", fontsize=9)
+    why = f"\n{record['explanation']}" if record.get("explanation") else ""
+    ax.set_title(f"{world.name}: {record['goal']} (SPL {_f(spl)}; {record.get('reason', '')}){why}", fontsize=9)
     ax.legend(loc="lower right", fontsize=7)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -146,10 +154,13 @@ def summary_markdown(records: list[Record], *, worst: list[Record], pictures: It
         lines += ["", "### By signage level", ""]
         lines += grouped_table(records, ["navigator", "signage"], lambda r: (nav(r), r.get("signage") or "-"))
     lines += ["", "### Failures by reason", ""]
-    failures = Counter((nav(r), reason_kind(r)) for r in records if not r["success"])
+    failures = Counter((nav(r), reason_kind(r), explanation_kind(r)) for r in records if not r["success"])
     if failures:
-        lines += ["| navigator | reason | trials |", "| --- | --- | --- |"]
-        lines += [f"| {n} | {reason} | {count} |" for (n, reason), count in sorted(failures.items())]
+        lines += ["Explanation: why the goal's label went unread, by the perception's reading rules along the path "
+                  "and what the robot knew (`sim/experiments/diagnosis.py`; particulars per trial in trials.csv):",
+                  "", *[f"- *{kind}*: {meaning}" for kind, meaning in KINDS.items()], "",
+                  "| navigator | reason | explanation | trials |", "| --- | --- | --- | --- |"]
+        lines += [f"| {n} | {reason} | {kind} | {count} |" for (n, reason, kind), count in sorted(failures.items())]
     else:
         lines.append("None: every trial found its goal.")
     lines += ["", "### Per world", ""]
@@ -159,7 +170,8 @@ def summary_markdown(records: list[Record], *, worst: list[Record], pictures: It
               "| # | world | navigator | goal | seed | result | distance (m) | oracle (m) | SPL | picture |",
               "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for i, (record, picture) in enumerate(zip(worst, pictures), 1):
-        result = "found" if record["success"] else f"failed: {record.get('reason', '')}"
+        result = "found" if record["success"] else f"failed: {record.get('reason', '')}" + \
+            (f"; {record['explanation']}" if record.get("explanation") else "")
         link = f"[path]({picture.relative_to(relative_to).as_posix()})" if picture is not None else "-"
         lines.append(f"| {i} | {record.get('world', '')} | {nav(record)} | {record['goal']} | {record['seed']} | "
                      f"{result} | {_f(record.get('distance_m'), '.1f')} | {_f(record.get('oracle_m'), '.1f')} | "

@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 
+from abstract_map.grammar import Anchor
+from sim.experiments.diagnosis import Explanation, ReadingRules, explain, names_place
 from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
 from sim.navigation.belief import BeliefParams
 from sim.navigation.follower import FollowerParams
@@ -122,6 +124,7 @@ class TrialResult:
     navigator: str = "paper"  # the navigation policy's name (sim.navigation.policies.NAVIGATORS)
     cpu_s: float = math.nan  # s of this process's CPU time: unlike wall time, not stretched by a busy machine
     unsettled: int = 0  # settles of the abstract map stopped by its step cap (DynamicsParams.max_iterations)
+    explanation: str = ""  # a failure's "kind: particulars" (sim.experiments.diagnosis); "" for a success
 
     @property
     def realtime_factor(self) -> float:
@@ -137,7 +140,7 @@ class TrialResult:
             "realtime_factor": round(self.realtime_factor, 2), "start": list(self.start),
             "cues": [asdict(c) for c in self.cues],
             "exploration_bumps": self.exploration_bumps, "settle_median_ms": round(self.settle_median_ms, 2),
-            "unsettled": self.unsettled,
+            "unsettled": self.unsettled, "explanation": self.explanation,
             "final_positions": {k: [round(v[0], 3), round(v[1], 3)] for k, v in self.final_positions.items()},
             "trajectory": [[round(float(v), 3) for v in row] for row in self.trajectory],
         }
@@ -338,6 +341,7 @@ class Trial:
             settle_median_ms=float(np.median(settle_ms)) if settle_ms else 0.0, frames=frames,
             grid_extent=self.grid.extent, navigator=self.navigator, cpu_s=time.process_time() - self.began_cpu,
             unsettled=sum(not s.settled for s in settles),
+            explanation="" if self.success else str(self.explain(self.goal, np.array(trajectory))),
         )
 
 
@@ -349,14 +353,48 @@ class Trial:
         for goal in self.watched:
             reading = self.readings.get(goal)
             if reading is None:
-                out[goal] = replace(result, goal=goal, success=False)
+                out[goal] = replace(result, goal=goal, success=False,
+                                    explanation=str(self.explain(goal, result.trajectory)))
                 continue
             trajectory = np.array([*self.trajectory[:reading.trajectory_len], (reading.t_s, *reading.pose)])
             out[goal] = replace(result, goal=goal, success=True, reason="goal label read",
                                 distance_m=reading.distance_m, sim_s=reading.t_s, wall_s=reading.wall_s,
                                 cpu_s=reading.cpu_s, trajectory=trajectory,
-                                frames=[f for f in result.frames if f.t_s <= reading.t_s])
+                                frames=[f for f in result.frames if f.t_s <= reading.t_s], explanation="")
         return out
+
+    def explain(self, goal: str, trajectory: np.ndarray) -> Explanation:
+        """Why ``goal``'s label was not read along ``trajectory`` (rows t s, x m, y m, theta rad: the true pose),
+        by the perception's reading rules from where the camera was, and what the navigator knew."""
+        sensor = getattr(self.sensor, "params", None)  # both perception modes state their reading rules
+        rules = ReadingRules(**{name: getattr(sensor, name) for name in ("max_range_m", "cone_half_angle_deg")
+                                if hasattr(sensor, name)})
+        x, y, z, _ = self.robot.camera_pose()
+        bx, by, heading = self.robot.true_pose()
+        ahead = complex(x - bx, y - by) * complex(math.cos(-heading), math.sin(-heading))  # camera in the robot frame
+        poses = np.asarray(trajectory, dtype=float).reshape(-1, 4)
+        cameras = poses[:, 1] + 1j * poses[:, 2] + ahead * np.exp(1j * poses[:, 3])
+        faces = [self.scene.tag_poses[tag] for tag in sorted(self.watched[goal])]
+        stop = getattr(sensor, "ray_stop_m", GeometricParams().ray_stop_m)
+
+        def sight(points: np.ndarray, label: int) -> np.ndarray:
+            face = faces[label]
+            end = [face.x + stop * math.cos(face.theta), face.y + stop * math.sin(face.theta), face.z]
+            origins = np.column_stack([points, np.full(len(points), z)])
+            return self.scene.ray_fractions(origins, np.tile(end, (len(points), 1))) >= 1.0
+
+        imagined = {name.casefold(): xy for name, xy in self.policy.picture()[0].items()}.get(goal.casefold())
+        return explain(poses[:, 0], np.column_stack([cameras.real, cameras.imag]),
+                       [(f.x, f.y, f.theta) for f in faces], rules=rules, sight=sight,
+                       named=None if getattr(NAVIGATORS.get(self.navigator), "goal_blind", False)
+                       else self._named(goal),
+                       imagined=None if imagined is None else (float(imagined[0]), float(imagined[1])))
+
+    def _named(self, goal: str) -> bool:
+        """Whether a sign the navigator read names ``goal``."""
+        signs = [(cue.text, self.world.tags[cue.tag_id]) for cue in self.policy.cues
+                 if cue.tag_id in self.world.tags and self.world.tags[cue.tag_id].kind != "label"]
+        return any(names_place(text, Anchor(f"#{tag.id}", tag.x, tag.y, tag.theta), goal) for text, tag in signs)
 
 
 def run_trial(world: World | str | os.PathLike[str], goal: str, *, seed: int = 0, perception: str = "camera",

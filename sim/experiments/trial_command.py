@@ -8,9 +8,10 @@ Example:
   abstract-map trial --world zoo --goal Kingfisher --out runs/k --log runs/k/run.rrd   (then: rerun runs/k/run.rrd)
 
 Prints a live progress line (simulated time, distance, cues read), then writes
-DIR/result.json (goal, success, reason, distance_m, simulated and wall seconds,
-cues read in order with the distance at each, the trajectory) and
-DIR/trajectory.png (floor plan, path, tags read, final imagined places).
+DIR/result.json (goal, success, reason, and for a failure its explanation: why the
+goal's label went unread, such as "passed edge-on: nearest 0.8 m at 231 s, 70 deg
+off its facing"; distance_m, simulated and wall seconds, cues read in order with the
+distance at each, the trajectory) and DIR/trajectory.png (floor plan, path, tags read, final imagined places).
 --record also writes DIR/run.gif, an animation of the robot, the explored map
 and the abstract map (with --navigator viewpoint or guided also the goal belief, magenta,
 and the swept space, blue). --log FILE.rrd writes a rerun recording on the
@@ -106,7 +107,7 @@ def run(args: argparse.Namespace) -> int:
     trajectory_picture(result, world, args.out / "trajectory.png")
     if args.record:
         animation(result, world, args.out / "run.gif")
-    verdict = "FOUND" if result.success else f"FAILED ({result.reason})"
+    verdict = "FOUND" if result.success else f"FAILED ({result.reason}; {result.explanation})"
     print(f"{args.goal}: {verdict} after {result.distance_m:.1f} m, {result.sim_s:.0f} s simulated in "
           f"{result.wall_s:.0f} s wall ({result.realtime_factor:.1f}x real time); wrote {args.out}/",
           file=sys.stderr)

@@ -171,7 +171,8 @@ def test_multi_world_study_resumes_across_worlds_and_refuses_other_settings(tiny
         ("tiny", "paper"), ("tiny", "frontier"), ("twin", "paper"), ("twin", "frontier")]
     assert all(r["oracle_m"] > 0 and r["spl"] is not None for r in first.records)
     rows = list(csv.DictReader((out / "trials.csv").open()))
-    assert {"world", "navigator", "oracle_m", "spl", "goal", "seed", "distance_m", "reason"} <= set(rows[0])
+    assert {"world", "navigator", "oracle_m", "spl", "goal", "seed", "distance_m", "reason",
+            "explanation"} <= set(rows[0])
     # resume: a trial file removed is the only one run again
     files = sorted((out / "trials").rglob("*.json"))
     assert len(files) == 4
@@ -196,7 +197,7 @@ def test_summary_groups_scores_and_lists_the_worst(tmp_path):
          "reason": "goal label read"},
         {"world": "a", "style": "office", "signage": "complete", "navigator": "frontier", "goal": "X", "seed": 0,
          "success": False, "distance_m": 300.0, "oracle_m": 30.0, "spl": 0.0, "oracle_ratio": None, "wall_s": 30.0,
-         "reason": "distance cap of 300 m reached"},
+         "reason": "distance cap of 300 m reached", "explanation": "reads no signs: nearest 9.4 m"},
         {"world": "b", "style": "museum", "signage": "sparse", "navigator": "paper", "goal": "Y", "seed": 0,
          "success": True, "distance_m": 20.0, "oracle_m": 20.0, "spl": 1.0, "oracle_ratio": 1.0, "wall_s": 5.0,
          "reason": "goal label read"},
@@ -207,7 +208,9 @@ def test_summary_groups_scores_and_lists_the_worst(tmp_path):
     assert [r["navigator"] for r in worst] == ["frontier", "paper"] and worst[1]["spl"] == 0.75
     text = summary_markdown(records, worst=worst, pictures=[tmp_path / "w" / "1.png", None], relative_to=tmp_path)
     assert "### By style" in text and "### By signage level" in text
-    assert "| frontier | distance cap of N m reached | 1 |" in text
+    assert "| frontier | distance cap of N m reached | reads no signs | 1 |" in text
+    assert "- *passed edge-on*: within range of the label only beside or behind it" in text  # the legend
+    assert "failed: distance cap of 300 m reached; reads no signs: nearest 9.4 m" in text  # the worst trials
     assert "[path](w/1.png)" in text
     assert "| paper | 100% (2/2) | 0.88 | 1.17 |" in text
 

@@ -14,7 +14,7 @@ from sim.experiments.trial import TrialParams, run_trial
 def test_tiny_trial_finds_the_label(tiny_world, perception):
     result = run_trial(tiny_world, "A", seed=1, perception=perception)
     assert result.success, result.reason
-    assert result.reason == "goal label read"
+    assert result.reason == "goal label read" and result.explanation == ""
     assert [c.tag_id for c in result.cues][-1] == 0
     assert 0.0 <= result.distance_m < 3.0
     steps = np.hypot(*np.diff(result.trajectory[:, 1:3], axis=0).T)
@@ -35,6 +35,7 @@ def test_caps_end_a_trial_with_a_reason(tiny_world, caps, reason):
     result = run_trial(tiny_world, "A", perception="geometric", params=TrialParams(**caps))
     assert not result.success and reason in result.reason
     assert result.sim_s == 0.0
+    assert result.explanation.startswith("never named: nearest 4.")  # nothing read yet, just out of range
 
 
 def test_unknown_goal_is_an_error(tiny_world):
@@ -79,11 +80,14 @@ def test_one_goal_blind_run_stands_for_one_trial_per_goal(tmp_path):
             shared.step()
         together = shared.results()
     assert together["Design Storeroom"].success and not together["Admin Office"].success
+    assert together["Admin Office"].explanation.split(":")[0] in ("reads no signs", "passed edge-on",
+                                                                  "hidden by walls")
     for goal in goals:
         alone = run_trial(world, goal, seed=2, perception="geometric", navigator="frontier", params=params)
         mine = together[goal]
         assert (mine.success, mine.distance_m, mine.sim_s) == (alone.success, alone.distance_m, alone.sim_s)
         assert mine.reason == alone.reason
+        assert mine.explanation == alone.explanation
         assert np.allclose(mine.trajectory[-1], alone.trajectory[-1])
 
 
