@@ -204,6 +204,22 @@ def generalise_tables(records: list[dict], title: str) -> None:
                          f"{s['spl']:.2f}", "-" if math.isnan(s["ratio"]) else f"{s['ratio']:.2f}",
                          f"{wall / len(mine):.1f}", f"{cpu / len(mine):.1f}", f"{wall / 60:.1f}"])
         table(f"{title}, per navigator and {column}", [h.format(column) for h in header], rows)
+    explained_failures(records, title)
+
+
+def explained_failures(records: list[dict], title: str) -> None:
+    """Failed trials per perception and navigator, by their explanation (``sim.experiments.diagnosis.KINDS``)."""
+    from collections import Counter
+
+    from sim.experiments.diagnosis import KINDS
+    from sim.experiments.summary import explanation_kind
+
+    counts = Counter((r["perception"], r["navigator"], explanation_kind(r)) for r in records if not r["success"])
+    kinds = [kind for kind in (*KINDS, "-") if any(key[2] == kind for key in counts)]
+    pairs = sorted({key[:2] for key in counts})
+    rows = [[perception, navigator, str(sum(counts[(perception, navigator, k)] for k in kinds)),
+             *[str(counts[(perception, navigator, k)]) for k in kinds]] for perception, navigator in pairs]
+    table(f"{title}, failures explained", ["perception", "navigator", "failed", *kinds], rows)
 
 
 def run_cost(records: list[dict], field: str) -> float:

@@ -33,6 +33,7 @@ def test_a_tiny_generalise_suite_runs_and_tabulates(tmp_path, capsys, monkeypatc
     run.bench_generalise(suite, workers=1, out=tmp_path / "gen")
     printed = capsys.readouterr().out
     assert "| geometric  | frontier  | all" in printed and "| geometric  | guided    | all" in printed
+    assert "failures explained" in printed and "reads no signs" in printed  # a 10 s frontier run finds nothing
     records = run.finished_trials(tmp_path / "gen")
     assert len(records) == 10  # 5 goals x 2 navigators; the frontier's 5 from one shared run
     assert {r["world"] for r in records} == {"gen-office-medium-sparse-1000"}
