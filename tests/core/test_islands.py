@@ -140,3 +140,25 @@ def test_a_refused_settle_leaves_the_next_one_to_count_each_spring_once(monkeypa
     monkeypatch.setattr(model_module, "run_dynamics", real)
     assert model.settle().settled
     assert model._index.count == Counter(model.resolved_springs())
+
+
+def test_finding_changes_position_by_position_settles_as_comparing_every_spring(monkeypatch):
+    """The cue-by-cue diff (model.spring_changes) against comparing the sets of all springs, as settles did
+    before it: the same positions, bit for bit, over a walk whose labels re-scale springs and re-place places."""
+    from abstract_map import model as model_module
+
+    def every_spring(old, new, members):
+        old_set, new_set = set(old), set(new)
+        return None if len(new_set) < len(new) else (list(new_set - old_set), list(old_set - new_set))
+
+    fast, walk = walked(0, 150)
+    slow, _ = walked(0, 150)
+    for tag, text, pose in walk.cues[:30]:
+        for model in (fast, slow):
+            model.observe_tag(tag, text, pose)
+            with monkeypatch.context() as patch:
+                if model is slow:
+                    patch.setattr(model_module, "spring_changes", every_spring)
+                model.settle()
+    assert fast.positions.keys() == slow.positions.keys()
+    assert all(np.array_equal(fast.positions[p], slow.positions[p]) for p in fast.positions)
