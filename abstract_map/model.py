@@ -555,7 +555,7 @@ class AbstractMap:
         settle carries on from there."""
         max_steps, max_s = settle_caps(max_steps, max_s)
         began = time.perf_counter()
-        springs = self._cached("resolved", self._resolved_springs, self.exploration_factor)  # shared: not changed
+        springs = self._cached("resolved", self._resolved_springs, self.exploration_factor)  # cached list: read only
         places = self.places()
         new = [p for p in places if p not in self.positions]
         disturbed = self._disturbed(springs, new, self.fixed)
