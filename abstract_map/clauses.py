@@ -69,3 +69,11 @@ def clause_from_dict(data: dict[str, object]) -> Clause:
         return Locational(str(data["kind"]), str(data["toponym"]), str(data["anchor"]),
                           float(data["direction"]))  # type: ignore[arg-type]
     raise ValueError(f"clause {data!r}: expected 'type' to be 'relational' or 'locational'")
+
+
+def clause_names(clause: Clause) -> list[str]:
+    """Every name a clause mentions: places and anchors (a relational clause's figure, referents and context; a
+    locational clause's toponym and anchor)."""
+    if isinstance(clause, Relational):
+        return [clause.figure, *clause.referents, *([clause.context] if clause.context else [])]
+    return [clause.toponym, clause.anchor]

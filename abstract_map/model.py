@@ -23,7 +23,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from . import errors
-from .clauses import START_ANCHOR, Clause, Locational, Relational, is_anchor, tag_anchor
+from .clauses import START_ANCHOR, Clause, Locational, Relational, clause_names, is_anchor, tag_anchor
 from .dynamics import SpringIndex
 from .dynamics import settle as run_dynamics
 from .errors import CueError, ModelError, UnknownPlaceError
@@ -78,7 +78,7 @@ class _Mentions:
         for clause in clauses:
             if isinstance(clause, Locational) and clause.kind == "label":
                 self.labels.setdefault(clause.toponym, []).append(clause.anchor)
-            for name in _clause_names(clause):
+            for name in clause_names(clause):
                 if not is_anchor(name):
                     self.names.setdefault(name, None)
 
@@ -223,7 +223,7 @@ class AbstractMap:
     def _places(self) -> list[str]:
         names = dict(self._mentions().names)
         for clause in self.loose_clauses:
-            names.update(dict.fromkeys(n for n in _clause_names(clause) if not is_anchor(n)))
+            names.update(dict.fromkeys(n for n in clause_names(clause) if not is_anchor(n)))
         return list(names)
 
     def _mentions(self) -> _Mentions:
@@ -278,7 +278,7 @@ class AbstractMap:
             if not is_anchor(clause.anchor):
                 raise CueError(f"clause {clause}: {clause.anchor!r} is not a fixed point")
             errors.number(f"clause {clause} direction", clause.direction, low=-4.0, high=4.0, error=CueError)
-        for name in _clause_names(clause):
+        for name in clause_names(clause):
             if not isinstance(name, str):
                 raise CueError(f"clause {clause}: a name must be text, got {errors.show(name)}")
             if is_anchor(name):
@@ -614,12 +614,6 @@ EXPLORATION_LAWS = {
     "multiplicative": lambda factor, step: factor * (1.0 + step),
     "additive": lambda factor, step: factor + step,
 }
-
-
-def _clause_names(clause: Clause) -> list[str]:
-    if isinstance(clause, Relational):
-        return [clause.figure, *clause.referents, *([clause.context] if clause.context else [])]
-    return [clause.toponym, clause.anchor]
 
 
 def imagined_positions(model: AbstractMap) -> Mapping[str, tuple[float, float]]:

@@ -20,7 +20,6 @@ from __future__ import annotations
 from array import array
 from collections.abc import Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from scipy.sparse import coo_matrix
@@ -236,7 +235,7 @@ class SpringField:
         self._parts: tuple[_Structure, _Structure] = (_Structure(), _Structure())
         self._arrays: tuple[np.ndarray, ...] = ()
         self._lengths = np.zeros(0)  # the front springs' l (m; 0 for distance springs), as of the last prepare
-        self._lengths_of: Any = None  # the spring index those lengths came from
+        self._lengths_of: SpringIndex | None = None  # the spring index those lengths came from
 
     def prepare(self, front: Sequence[Spring], resolved: Sequence[Resolved], index: SpringIndex, default: float,
                 values: np.ndarray | None = None) -> None:

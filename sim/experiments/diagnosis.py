@@ -27,9 +27,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from abstract_map.clauses import clause_names
 from abstract_map.errors import CueError
 from abstract_map.grammar import Anchor, parse_cue
-from sim.world.visibility import readable
+from sim.world.visibility import off_normal, readable
 
 KINDS = {  # kind -> what it means, in the order they are tried
     "readable, not read": "the label was in range, inside its reading cone and in sight, yet not read",
@@ -89,7 +90,7 @@ def explain(times: np.ndarray, cameras: np.ndarray, labels: Sequence[tuple[float
             continue
         in_cone = readable(cameras[:, 0], cameras[:, 1], x, y, facing, max_range_m=rules.max_range_m,
                            cone_half_angle_deg=rules.cone_half_angle_deg)
-        off = np.degrees(np.abs(np.remainder(np.arctan2(dy, dx) - facing + np.pi, 2.0 * np.pi) - np.pi))
+        off = np.degrees(off_normal(cameras[:, 0], cameras[:, 1], x, y, facing))
         if in_cone.any():
             chosen = np.flatnonzero(in_cone)
             clear = np.ones(len(chosen), dtype=bool) if sight is None else np.asarray(sight(cameras[chosen], number))
@@ -122,15 +123,11 @@ def explain(times: np.ndarray, cameras: np.ndarray, labels: Sequence[tuple[float
 
 
 def names_place(text: str, anchor: Anchor, place: str) -> bool:
-    """Whether the sign ``text`` hung at ``anchor`` names ``place`` (case aside) as a place its clauses locate or
-    relate. A sign the grammar cannot read names nothing (the abstract map refuses it too)."""
+    """Whether the sign ``text`` hung at ``anchor`` names ``place`` (case aside) in any of its clauses. A sign the
+    grammar cannot read names nothing (the abstract map refuses it too)."""
     try:
         clauses = parse_cue(text, anchor, kind="sign")
     except CueError:
         return False
     wanted = place.casefold()
-    for clause in clauses:
-        names = (getattr(clause, "toponym", None), getattr(clause, "figure", None), *getattr(clause, "referents", ()))
-        if any(isinstance(name, str) and name.casefold() == wanted for name in names):
-            return True
-    return False
+    return any(name.casefold() == wanted for clause in clauses for name in clause_names(clause))

@@ -170,8 +170,8 @@ def summary_markdown(records: list[Record], *, worst: list[Record], pictures: It
               "| # | world | navigator | goal | seed | result | distance (m) | oracle (m) | SPL | picture |",
               "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for i, (record, picture) in enumerate(zip(worst, pictures), 1):
-        result = "found" if record["success"] else f"failed: {record.get('reason', '')}" + \
-            (f"; {record['explanation']}" if record.get("explanation") else "")
+        why = f"; {record['explanation']}" if record.get("explanation") else ""
+        result = "found" if record["success"] else f"failed: {record.get('reason', '')}{why}"
         link = f"[path]({picture.relative_to(relative_to).as_posix()})" if picture is not None else "-"
         lines.append(f"| {i} | {record.get('world', '')} | {nav(record)} | {record['goal']} | {record['seed']} | "
                      f"{result} | {_f(record.get('distance_m'), '.1f')} | {_f(record.get('oracle_m'), '.1f')} | "

@@ -19,8 +19,15 @@ def readable(camera_x: ArrayLike, camera_y: ArrayLike, tag_x: ArrayLike, tag_y: 
     Camera or tag positions (and facings) may be numbers (a bool is returned) or arrays that broadcast
     (a bool array).
     """
-    dx, dy = np.subtract(camera_x, tag_x), np.subtract(camera_y, tag_y)
-    distance = np.hypot(dx, dy)
-    off_normal = np.abs(np.remainder(np.arctan2(dy, dx) - tag_theta + np.pi, 2.0 * np.pi) - np.pi)
-    ok = (distance <= max_range_m) & (distance > 0.0) & (off_normal <= math.radians(cone_half_angle_deg))
+    distance = np.hypot(np.subtract(camera_x, tag_x), np.subtract(camera_y, tag_y))
+    off = off_normal(camera_x, camera_y, tag_x, tag_y, tag_theta)
+    ok = (distance <= max_range_m) & (distance > 0.0) & (off <= math.radians(cone_half_angle_deg))
     return bool(ok) if np.ndim(ok) == 0 else ok
+
+
+def off_normal(camera_x: ArrayLike, camera_y: ArrayLike, tag_x: ArrayLike, tag_y: ArrayLike,
+               tag_theta: ArrayLike) -> Any:
+    """The angle (rad, in [0, pi]) between a tag's facing and the direction from the tag to the camera: 0 square in
+    front of it, pi/2 edge-on, pi behind it. Numbers or arrays that broadcast, as :func:`readable` takes."""
+    dx, dy = np.subtract(camera_x, tag_x), np.subtract(camera_y, tag_y)
+    return np.abs(np.remainder(np.arctan2(dy, dx) - tag_theta + np.pi, 2.0 * np.pi) - np.pi)
