@@ -30,10 +30,12 @@ from sim.navigation.planner import PlannerParams
 from sim.navigation.policies import NAVIGATORS, PolicyParams, make_policy
 from sim.navigation.replanner import ReplanParams
 from sim.navigation.routes import RouteParams
+from sim.navigation.spotted import SpottedParams
 from sim.navigation.targeting import TargetParams
 from sim.navigation.viewpoints import ViewpointParams
 from sim.perception import PERCEPTION_MODES, GeometricParams, Sighting, make_perception
 from sim.perception.laser import LaserParams, laser_angles, scan
+from sim.perception.spotting import SpotParams, Spotter
 from sim.world.data import World, load_world
 from sim.world.robot import Robot, RobotParams
 from sim.world.scene import SceneParams, build_scene
@@ -71,6 +73,8 @@ class TrialParams:
     viewpoints: ViewpointParams = field(default_factory=ViewpointParams)  # ... and how it values viewpoints
     routes: RouteParams = field(default_factory=RouteParams)  # ... and what arrows say of where the goal is
     guide: GuideParams = field(default_factory=GuideParams)  # the guided search's trade of path against evidence
+    spotted: SpottedParams = field(default_factory=SpottedParams)  # ... and how it uses plates seen, unread
+    spotting: SpotParams = field(default_factory=SpotParams)  # when a tag is seen to be there, unread
     laser: LaserParams = field(default_factory=LaserParams)
     occupancy_resolution_m: float = 0.1  # m, grid cell
 
@@ -167,7 +171,7 @@ def policy_params(params: TrialParams) -> PolicyParams:
     """The slice of the trial's parameters a navigation policy is built from."""
     return PolicyParams(params.navigator, params.planner, params.replan, params.follower, params.targeting,
                         params.target_recheck_s, params.belief, params.viewpoints, params.routes,
-                        params.guide)
+                        params.guide, params.spotted)
 
 
 Observer = Callable[["Trial"], None]
@@ -216,6 +220,7 @@ class Trial:
             self.robot = Robot(scene, params=RobotParams(odometry_noise_m=params.odometry_noise_m), rng=rng)
             self.robot.reset(*self.start)
             self.sensor = make_perception(perception, scene, rng=rng, **_perception_kwargs(perception, params))
+            self.spotter = Spotter(scene, params.spotting)
         except BaseException:
             scene.close()
             raise
@@ -269,7 +274,8 @@ class Trial:
             self.grid.integrate(pose, self.angles, self.scan, params.laser.max_range_m)
         if self.n % self.every["see"] == 0:
             self.sightings = self.sensor.observe(self.robot)
-            self.policy.observe(self.sightings, t_s=self.t, distance_m=self.distance, grid=self.grid)
+            self.policy.observe(self.sightings, t_s=self.t, distance_m=self.distance, grid=self.grid,
+                                spotted=self.spotter.spot(self.robot))
             seen = {s.tag_id for s in self.sightings}
             for name, tags in self.watched.items():
                 if name not in self.readings and tags & seen:

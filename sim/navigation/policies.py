@@ -19,13 +19,15 @@ differs is where it wants to go. Register a new one in :data:`NAVIGATORS`.
   cues say little (see ``docs/method-notes.md``).
 - ``guided``: a frontier search like ``frontier``'s, reading signs: the frontier
   with the most of that goal belief behind it per metre of path
-  (:mod:`sim.navigation.gateways`).
+  (:mod:`sim.navigation.gateways`), ruling out walls seen from afar without a
+  plate and stepping in front of plates seen but unread
+  (:mod:`sim.navigation.spotted`).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Protocol
 
@@ -49,9 +51,11 @@ from sim.navigation.routes import (
     passed_likelihood,
     route_likelihood,
 )
+from sim.navigation.spotted import SpottedParams, SpottedTags
 from sim.navigation.targeting import Target, TargetParams, choose_target
 from sim.navigation.viewpoints import ViewpointParams, Viewpoints, score_viewpoints, travel_costs
 from sim.perception.sighting import Sighting
+from sim.perception.spotting import Spot
 from sim.world.data import World
 
 Pose = tuple[float, float, float]
@@ -71,6 +75,7 @@ class PolicyParams:
     viewpoints: ViewpointParams = field(default_factory=ViewpointParams)
     routes: RouteParams = field(default_factory=RouteParams)
     guide: GuideParams = field(default_factory=GuideParams)
+    spotted: SpottedParams = field(default_factory=SpottedParams)
 
 
 class Policy(Protocol):
@@ -80,8 +85,8 @@ class Policy(Protocol):
     gave_up: str  # why the policy stopped (non-empty ends the trial)
 
     def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
-                grid: OccupancyGrid) -> None:
-        """Take in the tags read now."""
+                grid: OccupancyGrid, spotted: Sequence[Spot] = ()) -> None:
+        """Take in the tags read now, and the tags seen but not read (:mod:`sim.perception.spotting`)."""
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:
@@ -153,7 +158,7 @@ class AbstractMapPolicy:
         return self.nav.cues
 
     def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
-                grid: OccupancyGrid) -> None:
+                grid: OccupancyGrid, spotted: Sequence[Spot] = ()) -> None:
         if self.nav.observe(sightings, t_s=t_s, distance_m=distance_m, explored_centre=grid.explored_centre):
             self.forget_target()
 
@@ -299,17 +304,22 @@ class FrontierSearch:
         self.target: np.ndarray | None = None
         self.chosen_at = self.checked_at = -float("inf")
         self.visited: list[np.ndarray] = []
+        self.arrived_at: np.ndarray | None = None  # the target latest reached, until the caller takes it
         self.looked = LookedAt()
+        self.unlooked: np.ndarray | None = None  # bool, the grid's shape: space to count as not yet looked at
+        # whatever the looks say (the reading zones of plates seen but unread); None: none
         self.exhausted = False
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float, rng: np.random.Generator,
                 value: Callable[[np.ndarray], np.ndarray | None] = lambda covered: None,
                 offset_m: float = 0.0, floor: float = 1e-6) -> tuple[float, float]:
         """The wheel command (m/s, rad/s) towards the frontier of least path length, or with ``value(covered)``
-        (per grid cell, given the cells looked at; None: path alone) of least ``(path + offset_m) / value``
-        (a value below ``floor`` times the best counting as that)."""
+        (per grid cell, given the cells looked at, :attr:`unlooked` taken out; None: path alone) of least
+        ``(path + offset_m) / value`` (a value below ``floor`` times the best counting as that)."""
         radius = self.params.planner.robot_radius_m
         covered = self.looked.update(grid, np.array(pose[:2]), self.frontier)
+        if self.unlooked is not None and self.unlooked.shape == covered.shape:
+            covered = covered & ~self.unlooked
         if self.target is not None and t_s - self.checked_at >= self.frontier.recheck_s:
             self.checked_at = t_s
             if not still_frontier(grid, self.target, radius, self.frontier, covered):
@@ -326,6 +336,7 @@ class FrontierSearch:
         if arrived:
             self.visited.append(self.target)
             self.target = None
+            self.arrived_at = self.visited[-1]
         return v, w
 
     def shown(self) -> tuple[float, float]:
@@ -351,7 +362,7 @@ class FrontierPolicy:
         self.gave_up = ""
 
     def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
-                grid: OccupancyGrid) -> None:
+                grid: OccupancyGrid, spotted: Sequence[Spot] = ()) -> None:
         """Signs are not read: nothing to take in."""
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
@@ -462,8 +473,11 @@ class GuidedPolicy(AbstractMapPolicy):
     and little where the robot has already looked. Each frontier is worth the
     belief whose route from the robot enters unlooked space through it
     (:func:`sim.navigation.gateways.frontier_values`), so a corridor's open end
-    carries all it leads to and a room's doorway only the room. The search is
-    complete: it ends when the goal's label is read or no frontier is left.
+    carries all it leads to and a room's doorway only the room. Walls seen from
+    afar with no plate on them are ruled out, and the space in front of each
+    plate seen but not yet read counts as unlooked, so the robot steps in front
+    of it (:mod:`sim.navigation.spotted`). The search is complete: it ends when
+    the goal's label is read or no frontier is left.
     """
 
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
@@ -471,21 +485,50 @@ class GuidedPolicy(AbstractMapPolicy):
         frontier = replace(FrontierParams(), min_distance_m=params.guide.min_target_m)
         self.search = FrontierSearch(params, self.drive, frontier, params.guide.rechoose_s)
         self.belief: Belief | None = None  # the latest goal belief, for drawing
+        self.tags = SpottedTags(params.spotted)
+        sp = params.spotted
+        self.seen_from_afar: SweptSpace | None = None  # walls seen in the spotting rule: no unseen plate there
+        self.seen_params = replace(params.belief, read_range_m=sp.sweep_range_m, read_min_m=0.0,
+                                   cone_half_angle_deg=sp.sweep_cone_deg)
+        self.seen_at = -float("inf")
+        self.zones_version = -1
 
     def forget_target(self) -> None:
         self.search.target = None
 
+    def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
+                grid: OccupancyGrid, spotted: Sequence[Spot] = ()) -> None:
+        sightings = list(sightings)
+        super().observe(sightings, t_s=t_s, distance_m=distance_m, grid=grid)
+        self.tags.update(sightings, spotted)
+
     def _values(self, grid: OccupancyGrid, covered: np.ndarray, robot_xy: np.ndarray) -> np.ndarray:
-        """Per grid cell, the goal belief behind it (:func:`sim.navigation.gateways.frontier_values`)."""
-        self.belief = goal_belief(grid, covered, self.goal_prior(), self.params.belief, self._evidence(grid))
-        return frontier_values(grid, self.belief.mass, covered, robot_xy, self.params.guide, self.params.routes)
+        """Per grid cell, the goal belief behind it (:func:`sim.navigation.gateways.frontier_values`), and in
+        front of each plate seen but unread, the belief on that plate."""
+        plates, read = self.tags.tag_cells(grid), self.tags.read_cells(grid)
+        swept = covered if self.seen_from_afar is None else covered | self.seen_from_afar.swept
+        swept = (swept & ~plates) | read
+        self.belief = goal_belief(grid, swept, self.goal_prior(), self.params.belief, self._evidence(grid))
+        values = frontier_values(grid, self.belief.mass, covered, robot_xy, self.params.guide, self.params.routes)
+        return np.maximum(values, self.tags.zone_values(grid, self.belief.mass))
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:
         self.now = t_s
         robot_xy = np.array(pose[:2])
+        if self.seen_from_afar is None or self.seen_from_afar.swept.shape != grid.shape:
+            self.seen_from_afar = SweptSpace(grid, self.seen_params)
+        if t_s - self.seen_at >= self.params.spotted.sweep_every_s:
+            self.seen_from_afar.sweep(grid, robot_xy)
+            self.seen_at = t_s
+        if self.zones_version != self.tags.version:
+            self.search.unlooked = self.tags.zones(grid)
+            self.zones_version = self.tags.version
         v, w = self.search.command(t_s, pose, grid, tick_s, rng, value=lambda covered: self._values(
             grid, covered, robot_xy), offset_m=self.params.guide.offset_m, floor=self.params.guide.floor)
+        if self.search.arrived_at is not None:
+            self.tags.give_up_at(grid, self.search.arrived_at)
+            self.search.arrived_at = None
         if self.search.exhausted:
             self.gave_up = NO_FRONTIER
         return v, w
@@ -500,8 +543,10 @@ class GuidedPolicy(AbstractMapPolicy):
         if self.belief is not None:
             peak = float(self.belief.mass.max())
             out["belief"] = self.belief.mass / peak if peak > 0 else self.belief.mass
-        if self.search.looked.covered is not None:
-            out["swept"] = self.search.looked.covered
+        covered, seen = self.search.looked.covered, self.seen_from_afar
+        if covered is not None:
+            afar = seen is not None and seen.swept.shape == covered.shape
+            out["swept"] = covered | seen.swept if afar else covered
         return out
 
 

@@ -4,7 +4,9 @@ Tags come as :class:`Sighting` s in the world frame. Two modes share
 ``observe(robot) -> list[Sighting]``: ``"camera"`` renders a panoramic camera
 and detects AprilTags in the images; ``"geometric"`` decides from the map
 (range, reading cone, field of view, line of sight). The laser (``laser``)
-casts its beams over the floor plan. May import ``sim.world``.
+casts its beams over the floor plan, and the spotter (``spotting``) reports
+the tags seen from afar but not read, by where they hang. May import
+``sim.world``.
 """
 
 from __future__ import annotations

@@ -73,3 +73,31 @@ def test_family_labels_are_the_goals_siblings_read(tmp_path):
     read = policy.family_labels()
     assert sorted(map(tuple, read.round(3))) == sorted((round(t.x, 3), round(t.y, 3)) for t in siblings)
     assert np.isfinite(read).all()
+
+
+def test_guided_stands_in_front_of_a_plate_seen_until_it_is_read(tiny_world):
+    """A plate seen but unread opens a reading zone the search goes to; reading it closes the zone."""
+    import numpy as np
+
+    from sim.experiments.trial import TrialParams, occupancy_grid, policy_params
+    from sim.navigation.policies import GuidedPolicy
+    from sim.perception.sighting import Sighting
+    from sim.perception.spotting import Spot
+
+    params = TrialParams()
+    goal = sorted(tiny_world.goals)[0]
+    tag = tiny_world.tags[1]  # the free-standing sign at (3, 6) facing +y, 2 m short of the outer wall
+    policy = GuidedPolicy(tiny_world, goal, tiny_world.start, policy_params(params))
+    grid = occupancy_grid(tiny_world, params)
+    rng = np.random.default_rng(0)
+    spot = Spot(tag.x, tag.y, tag.theta, 6.0)
+    policy.observe([], t_s=0.0, distance_m=0.0, grid=grid, spotted=[spot])
+    policy.command(0.0, tiny_world.start, grid, 0.2, rng)
+    zone = policy.search.unlooked
+    assert zone is not None and zone.any()
+    front = grid.world_to_cell(np.array([tag.x + 1.5 * np.cos(tag.theta), tag.y + 1.5 * np.sin(tag.theta)]))[0]
+    assert zone[front[0], front[1]]
+    policy.observe([Sighting(tag.id, tag.x, tag.y, tag.theta, 2.0)], t_s=0.4, distance_m=0.0, grid=grid,
+                   spotted=[spot])
+    policy.command(0.4, tiny_world.start, grid, 0.2, rng)
+    assert policy.search.unlooked is not None and not policy.search.unlooked.any()

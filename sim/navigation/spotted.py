@@ -1,0 +1,154 @@
+"""Tags seen but not yet read: where the goal's label can only be, once a wall has been seen from afar.
+
+Labels are plates on walls, and the robot sees a plate long before it can
+read it (:mod:`sim.perception.spotting`: 8 m, 75 degrees off its normal,
+against reading's 4 m and 45). So a wall seen within that rule without a plate
+on it holds no label, and a plate seen but unread may be the goal's label or a
+sign that names it. :class:`SpottedTags` keeps the plates seen and not yet
+read, and gives the guided search three grids (the occupancy grid's cells):
+
+- ``tag_cells``: the cells of unread plates (the belief keeps them unswept,
+  whatever the look says);
+- ``read_cells``: the cells of plates read (not the goal's label: swept);
+- ``zones``: for each unread plate, the free space in front of it from which it
+  is read (square to it, 1.2-3 m out): the search treats that space as not yet
+  looked at, so a frontier forms there and carries the plate's belief, and the
+  robot drives to stand in front of it.
+
+World frame, metres.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim.mapping.occupancy import OccupancyGrid
+from sim.perception.sighting import Sighting
+from sim.perception.spotting import Spot
+
+
+@dataclass(frozen=True)
+class SpottedParams:
+    """How plates seen but unread are kept and approached."""
+
+    same_tag_m: float = 0.3  # m; reports of plates this close are one plate (spots and sightings are true poses)
+    tag_radius_m: float = 0.25  # m; cells this close to a plate's centre are its cells (a plate is ~0.25 m wide)
+    zone_near_m: float = 1.2  # m in front of a plate where its reading zone starts: the camera misses nearer tags
+    zone_far_m: float = 3.0  # m where it ends: inside the 4 m reading range with the sweep's margin
+    zone_half_angle_deg: float = 30.0  # deg about the plate's normal: inside the 45-degree reading cone, so the
+    # zone's edge, where the robot arrives, still reads it
+    sweep_range_m: float = 7.5  # m; a wall this close, seen in the spotting cone, would have shown its plate:
+    # the spotter's 8 m less a margin
+    sweep_cone_deg: float = 70.0  # deg about the wall's normal: the spotter's 75 less a margin
+    sweep_every_s: float = 0.4  # s of simulated time between such sweeps: the perception's 2.5 Hz
+
+
+class SpottedTags:
+    """Plates seen and not yet read, and plates read, by where they hang."""
+
+    def __init__(self, params: SpottedParams | None = None) -> None:
+        self.params = params or SpottedParams()
+        self.unread: list[Spot] = []
+        self.read: list[tuple[float, float]] = []
+        self.version = 0  # bumped whenever either list changes
+
+    def update(self, sightings: Iterable[Sighting], spots: Iterable[Spot]) -> bool:
+        """Take in the plates read and seen now; True when anything changed."""
+        changed = False
+        for s in sightings:
+            if not self._near(self.read, s.x, s.y):
+                self.read.append((s.x, s.y))
+                changed = True
+        keep = [u for u in self.unread if not self._near(self.read, u.x, u.y)]
+        changed |= len(keep) != len(self.unread)
+        self.unread = keep
+        for spot in spots:
+            if not self._near(self.read, spot.x, spot.y) and not self._near(
+                    [(u.x, u.y) for u in self.unread], spot.x, spot.y):
+                self.unread.append(spot)
+                changed = True
+        if changed:
+            self.version += 1
+        return changed
+
+    def _near(self, points: list[tuple[float, float]], x: float, y: float) -> bool:
+        return any(math.hypot(px - x, py - y) <= self.params.same_tag_m for px, py in points)
+
+    def tag_cells(self, grid: OccupancyGrid) -> np.ndarray:
+        """Bool, the grid's shape: cells within ``tag_radius_m`` of an unread plate."""
+        return self._disc_cells(grid, [(u.x, u.y) for u in self.unread])
+
+    def read_cells(self, grid: OccupancyGrid) -> np.ndarray:
+        """Bool, the grid's shape: cells within ``tag_radius_m`` of a plate read."""
+        return self._disc_cells(grid, self.read)
+
+    def _disc_cells(self, grid: OccupancyGrid, points: list[tuple[float, float]]) -> np.ndarray:
+        out = np.zeros(grid.shape, dtype=bool)
+        if not points:
+            return out
+        xs, ys = grid.cell_axes()
+        r = self.params.tag_radius_m
+        for x, y in points:
+            cols = np.flatnonzero(np.abs(xs - x) <= r)
+            rows = np.flatnonzero(np.abs(ys - y) <= r)
+            if cols.size == 0 or rows.size == 0:
+                continue
+            block = np.hypot(xs[cols][None, :] - x, ys[rows][:, None] - y) <= r
+            out[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1] |= block
+        return out
+
+    def _zone_blocks(self, grid: OccupancyGrid):
+        """For each unread plate: (plate, rows slice, cols slice, its zone on that window (bool))."""
+        prm = self.params
+        xs, ys = grid.cell_axes()
+        cos_min = math.cos(math.radians(prm.zone_half_angle_deg))
+        for u in self.unread:
+            cols = np.flatnonzero(np.abs(xs - u.x) <= prm.zone_far_m)
+            rows = np.flatnonzero(np.abs(ys - u.y) <= prm.zone_far_m)
+            if cols.size == 0 or rows.size == 0:
+                continue
+            dx, dy = xs[cols][None, :] - u.x, ys[rows][:, None] - u.y
+            d = np.hypot(dx, dy)
+            ahead = (dx * math.cos(u.theta) + dy * math.sin(u.theta)) >= d * cos_min
+            yield u, slice(rows[0], rows[-1] + 1), slice(cols[0], cols[-1] + 1), \
+                ahead & (d >= prm.zone_near_m) & (d <= prm.zone_far_m)
+
+    def zones(self, grid: OccupancyGrid) -> np.ndarray:
+        """Bool, the grid's shape: cells not on a mapped wall in front of an unread plate from which it is read
+        (``zone_near_m`` to ``zone_far_m`` out, within ``zone_half_angle_deg`` of its normal)."""
+        out = np.zeros(grid.shape, dtype=bool)
+        for _, rows, cols, zone in self._zone_blocks(grid):
+            out[rows, cols] |= zone
+        return out & ~grid.occupied_mask()
+
+    def zone_values(self, grid: OccupancyGrid, mass: np.ndarray) -> np.ndarray:
+        """Per cell, the belief ``mass`` (the grid's shape) on the plate whose reading zone holds it (the most,
+        where zones overlap): what standing there would read."""
+        out = np.zeros(grid.shape)
+        disc = self.params.tag_radius_m
+        xs, ys = grid.cell_axes()
+        for u, rows, cols, zone in self._zone_blocks(grid):
+            near = np.hypot(xs[cols][None, :] - u.x, ys[rows][:, None] - u.y) <= disc
+            on_plate = float(mass[rows, cols][near].sum())
+            out[rows, cols] = np.maximum(out[rows, cols], np.where(zone, on_plate, 0.0))
+        return out
+
+    def give_up_at(self, grid: OccupancyGrid, xy: np.ndarray) -> bool:
+        """The robot stood at ``xy`` (m) and read no plate whose zone holds it: those plates cannot be read from
+        where the robot gets to (hidden, or out of reach) and count as read. True when any did."""
+        rc = grid.world_to_cell(np.asarray(xy, dtype=float))[0]
+        dropped = []
+        for u, rows, cols, zone in self._zone_blocks(grid):
+            r, c = int(rc[0]) - rows.start, int(rc[1]) - cols.start
+            if 0 <= r < zone.shape[0] and 0 <= c < zone.shape[1] and zone[r, c]:
+                dropped.append(u)
+        if not dropped:
+            return False
+        self.unread = [u for u in self.unread if u not in dropped]
+        self.read += [(u.x, u.y) for u in dropped]
+        self.version += 1
+        return True
