@@ -220,7 +220,9 @@ class Trial:
             self.robot = Robot(scene, params=RobotParams(odometry_noise_m=params.odometry_noise_m), rng=rng)
             self.robot.reset(*self.start)
             self.sensor = make_perception(perception, scene, rng=rng, **_perception_kwargs(perception, params))
-            self.spotter = Spotter(scene, params.spotting)
+            # plates seen from afar, unread: spotted only for a navigator that takes them in
+            uses_spots = getattr(NAVIGATORS.get(navigator), "spots", False)
+            self.spotter = Spotter(scene, params.spotting) if uses_spots else None
         except BaseException:
             scene.close()
             raise
@@ -275,7 +277,7 @@ class Trial:
         if self.n % self.every["see"] == 0:
             self.sightings = self.sensor.observe(self.robot)
             self.policy.observe(self.sightings, t_s=self.t, distance_m=self.distance, grid=self.grid,
-                                spotted=self.spotter.spot(self.robot))
+                                spotted=() if self.spotter is None else self.spotter.spot(self.robot))
             seen = {s.tag_id for s in self.sightings}
             for name, tags in self.watched.items():
                 if name not in self.readings and tags & seen:

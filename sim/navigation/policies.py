@@ -480,6 +480,8 @@ class GuidedPolicy(AbstractMapPolicy):
     the goal's label is read or no frontier is left.
     """
 
+    spots = True  # takes in the plates seen but unread (``observe(..., spotted=...)``); other policies ignore them
+
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
         super().__init__(world, goal, start, params)
         frontier = replace(FrontierParams(), min_distance_m=params.guide.min_target_m)

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim.mapping.occupancy import OccupancyGrid
+from sim.navigation.belief import cell_window
 from sim.perception.sighting import Sighting
 from sim.perception.spotting import Spot
 
@@ -88,40 +89,29 @@ class SpottedTags:
 
     def _disc_cells(self, grid: OccupancyGrid, points: list[tuple[float, float]]) -> np.ndarray:
         out = np.zeros(grid.shape, dtype=bool)
-        if not points:
-            return out
-        xs, ys = grid.cell_axes()
-        r = self.params.tag_radius_m
+        axes = grid.cell_axes()
         for x, y in points:
-            cols = np.flatnonzero(np.abs(xs - x) <= r)
-            rows = np.flatnonzero(np.abs(ys - y) <= r)
-            if cols.size == 0 or rows.size == 0:
-                continue
-            block = np.hypot(xs[cols][None, :] - x, ys[rows][:, None] - y) <= r
-            out[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1] |= block
+            rows, cols, dx, dy = _around(grid, axes, x, y, self.params.tag_radius_m)
+            out[rows, cols] |= np.hypot(dx, dy) <= self.params.tag_radius_m
         return out
 
     def _zone_blocks(self, grid: OccupancyGrid):
-        """For each unread plate: (plate, rows slice, cols slice, its zone on that window (bool))."""
+        """For each unread plate: (plate, rows slice, cols slice, its zone on that window (bool), each window
+        cell's distance from the plate (m))."""
         prm = self.params
-        xs, ys = grid.cell_axes()
+        axes = grid.cell_axes()
         cos_min = math.cos(math.radians(prm.zone_half_angle_deg))
         for u in self.unread:
-            cols = np.flatnonzero(np.abs(xs - u.x) <= prm.zone_far_m)
-            rows = np.flatnonzero(np.abs(ys - u.y) <= prm.zone_far_m)
-            if cols.size == 0 or rows.size == 0:
-                continue
-            dx, dy = xs[cols][None, :] - u.x, ys[rows][:, None] - u.y
+            rows, cols, dx, dy = _around(grid, axes, u.x, u.y, prm.zone_far_m)
             d = np.hypot(dx, dy)
             ahead = (dx * math.cos(u.theta) + dy * math.sin(u.theta)) >= d * cos_min
-            yield u, slice(rows[0], rows[-1] + 1), slice(cols[0], cols[-1] + 1), \
-                ahead & (d >= prm.zone_near_m) & (d <= prm.zone_far_m)
+            yield u, rows, cols, ahead & (d >= prm.zone_near_m) & (d <= prm.zone_far_m), d
 
     def zones(self, grid: OccupancyGrid) -> np.ndarray:
         """Bool, the grid's shape: cells not on a mapped wall in front of an unread plate from which it is read
         (``zone_near_m`` to ``zone_far_m`` out, within ``zone_half_angle_deg`` of its normal)."""
         out = np.zeros(grid.shape, dtype=bool)
-        for _, rows, cols, zone in self._zone_blocks(grid):
+        for _, rows, cols, zone, _ in self._zone_blocks(grid):
             out[rows, cols] |= zone
         return out & ~grid.occupied_mask()
 
@@ -129,11 +119,8 @@ class SpottedTags:
         """Per cell, the belief ``mass`` (the grid's shape) on the plate whose reading zone holds it (the most,
         where zones overlap): what standing there would read."""
         out = np.zeros(grid.shape)
-        disc = self.params.tag_radius_m
-        xs, ys = grid.cell_axes()
-        for u, rows, cols, zone in self._zone_blocks(grid):
-            near = np.hypot(xs[cols][None, :] - u.x, ys[rows][:, None] - u.y) <= disc
-            on_plate = float(mass[rows, cols][near].sum())
+        for _, rows, cols, zone, d in self._zone_blocks(grid):
+            on_plate = float(mass[rows, cols][d <= self.params.tag_radius_m].sum())
             out[rows, cols] = np.maximum(out[rows, cols], np.where(zone, on_plate, 0.0))
         return out
 
@@ -142,7 +129,7 @@ class SpottedTags:
         where the robot gets to (hidden, or out of reach) and count as read. True when any did."""
         rc = grid.world_to_cell(np.asarray(xy, dtype=float))[0]
         dropped = []
-        for u, rows, cols, zone in self._zone_blocks(grid):
+        for u, rows, cols, zone, _ in self._zone_blocks(grid):
             r, c = int(rc[0]) - rows.start, int(rc[1]) - cols.start
             if 0 <= r < zone.shape[0] and 0 <= c < zone.shape[1] and zone[r, c]:
                 dropped.append(u)
@@ -152,3 +139,14 @@ class SpottedTags:
         self.read += [(u.x, u.y) for u in dropped]
         self.version += 1
         return True
+
+
+def _around(grid: OccupancyGrid, axes: tuple[np.ndarray, np.ndarray], x: float, y: float, reach_m: float
+            ) -> tuple[slice, slice, np.ndarray, np.ndarray]:
+    """The window of ``grid`` holding every cell within ``reach_m`` of (``x``, ``y``) (m): its rows and columns
+    (empty off the grid), and each column's and row's offset from the point (m; (1, cols) and (rows, 1)), from
+    ``axes``, the grid's :meth:`~sim.mapping.occupancy.OccupancyGrid.cell_axes`."""
+    rc = grid.world_to_cell(np.array([x, y], dtype=float))[0]
+    r0, r1, c0, c1 = cell_window(rc, int(math.ceil(reach_m / grid.resolution)) + 1, grid.shape)
+    rows, cols = slice(r0, max(r0, r1)), slice(c0, max(c0, c1))
+    return rows, cols, axes[0][cols][None, :] - x, axes[1][rows][:, None] - y

@@ -101,3 +101,11 @@ def test_guided_stands_in_front_of_a_plate_seen_until_it_is_read(tiny_world):
                    spotted=[spot])
     policy.command(0.4, tiny_world.start, grid, 0.2, rng)
     assert policy.search.unlooked is not None and not policy.search.unlooked.any()
+
+
+@pytest.mark.parametrize("navigator, spots", [("guided", True), ("paper", False), ("frontier", False)])
+def test_plates_are_spotted_only_for_a_navigator_that_takes_them_in(tiny_world, navigator, spots):
+    from sim.experiments.trial import Trial
+
+    with Trial(tiny_world, "A", perception="geometric", navigator=navigator) as trial:
+        assert (trial.spotter is not None) == spots
