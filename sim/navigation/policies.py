@@ -508,8 +508,7 @@ class GuidedPolicy(AbstractMapPolicy):
         """Per grid cell, the goal belief behind it (:func:`sim.navigation.gateways.frontier_values`), and in
         front of each plate seen but unread, the belief on that plate."""
         plates, read = self.tags.tag_cells(grid), self.tags.read_cells(grid)
-        swept = covered if self.seen_from_afar is None else covered | self.seen_from_afar.swept
-        swept = (swept & ~plates) | read
+        swept = (self._looked_or_seen(covered) & ~plates) | read
         self.belief = goal_belief(grid, swept, self.goal_prior(), self.params.belief, self._evidence(grid))
         values = frontier_values(grid, self.belief.mass, covered, robot_xy, self.params.guide, self.params.routes)
         return np.maximum(values, self.tags.zone_values(grid, self.belief.mass))
@@ -545,11 +544,14 @@ class GuidedPolicy(AbstractMapPolicy):
         if self.belief is not None:
             peak = float(self.belief.mass.max())
             out["belief"] = self.belief.mass / peak if peak > 0 else self.belief.mass
-        covered, seen = self.search.looked.covered, self.seen_from_afar
-        if covered is not None:
-            afar = seen is not None and seen.swept.shape == covered.shape
-            out["swept"] = covered | seen.swept if afar else covered
+        if self.search.looked.covered is not None:
+            out["swept"] = self._looked_or_seen(self.search.looked.covered)
         return out
+
+    def _looked_or_seen(self, covered: np.ndarray) -> np.ndarray:
+        """``covered`` (the cells looked at) and the walls seen from afar with no plate on them."""
+        seen = self.seen_from_afar
+        return covered | seen.swept if seen is not None and seen.swept.shape == covered.shape else covered
 
 
 NAVIGATORS: dict[str, type] = {

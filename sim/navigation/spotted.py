@@ -21,7 +21,7 @@ World frame, metres.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,7 +95,7 @@ class SpottedTags:
             out[rows, cols] |= np.hypot(dx, dy) <= self.params.tag_radius_m
         return out
 
-    def _zone_blocks(self, grid: OccupancyGrid):
+    def _zone_blocks(self, grid: OccupancyGrid) -> Iterator[tuple[Spot, slice, slice, np.ndarray, np.ndarray]]:
         """For each unread plate: (plate, rows slice, cols slice, its zone on that window (bool), each window
         cell's distance from the plate (m))."""
         prm = self.params
