@@ -243,8 +243,7 @@ def _net_force(names: Sequence[str], index: SpringIndex, expanding: Collection[s
     gathered from ``field`` (a prepared ``resolution.SpringField``) if given."""
     laws = {"expand": [e in expanding for e in names],
             "centre": None if centre is None else complex(float(centre[0]), float(centre[1])),
-            "expansion": params.expansion, "law": params.expansion_law, "core": params.angle_core,
-            "share": params.angle_core_share}
+            "expansion": params.expansion, "law": params.expansion_law, "core": params.core}
     if field is not None:
         return field.around(names, **laws)
     around = [s for s in index.around(names) for _ in range(index.count[s])]

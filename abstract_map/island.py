@@ -69,7 +69,7 @@ class Island:
         self._buffer = pymunk.batch.Buffer()
         self._forces = np.zeros(0, dtype=complex)
         self._force_buffer = pymunk.batch.Buffer()
-        self._angles = AngleSprings(0, [], [], [], core=params.angle_core, share=params.angle_core_share)
+        self._angles = AngleSprings(0, [], [], [], core=params.core)
         self._still = np.zeros(0, dtype=complex)  # positions (m) of the masses the angle springs hold still
 
     @property
@@ -149,7 +149,7 @@ class Island:
         self._still = np.array([complex(*self.bodies[name].position) for name in still], dtype=complex)
         lengths = [self.index.length(s, self.params.angle_length) for s in chosen]
         self._angles = AngleSprings(len(slot), chosen, [[slot[e] for e in s.ends] for s in chosen], lengths,
-                                    core=self.params.angle_core, share=self.params.angle_core_share)
+                                    core=self.params.core)
         self._forces = np.zeros(len(self.space.bodies), dtype=complex)  # pymunk's order: the island's first
         self._force_buffer = pymunk.batch.Buffer()
         self._force_buffer.set_float_buf(self._forces)

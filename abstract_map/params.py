@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from .forces import EXPANSION_LAWS
+from .forces import EXPANSION_LAWS, Core
 
 STIFFNESS: dict[str, float] = {"XL": 2.5, "L": 1.0, "M": 0.5, "S": 0.1, "XS": 0.01}
 """Named spring stiffnesses (N/m for distance springs, N/rad for angle springs)."""
@@ -71,13 +71,19 @@ class DynamicsParams:
     expansion_law: str = "constant"  # "constant" (authors' code) or "proportional" (paper's text)
     expansion_on: str = "leaves"  # "leaves" (authors' code) or "all" free masses
     min_separation: float = 0.2  # m between free masses (they bounce)
-    # m, the angle springs' force is held at its value this far from their pivot nearer in, where the direction is
-    # ill-defined (the authors' code faded it to zero inside the same 0.5 m)
+    # m, the angle springs' energy fades as (r / floor)^2 within floor = max(angle_core, angle_core_share * l) of
+    # their pivot, where the direction is ill-defined (the authors' code faded the force to zero inside the same
+    # 0.5 m); the force stays the energy's gradient (forces.py), so nothing can circle a pivot for ever
     angle_core: float = 0.5
-    # of an angle spring's l: the force is held at its value at this share of l nearer in, so no angle spring
-    # pushes harder than 1 / share times the paper's K * error (forces.py): a place that passes close to a
-    # pivot is not flung round it, which at dt = 0.1 s feeds energy into the system
+    # of an angle spring's l: the floor is at least this share of l, so no angle spring pushes tangentially harder
+    # than 1 / share times the paper's K * error: a place that passes close to a pivot is not flung round it
     angle_core_share: float = 0.25
+    # w dt (rad) the steepest part of a core may reach: within the floor a spring's pull toward its pivot stiffens
+    # to K l error^2 / floor^2 (<= pi^2 K l / floor^2), so the floor is at least pi dt sqrt(K l / mass) / this.
+    # pymunk's semi-implicit Euler is stable below 2; 1 leaves room for springs that share a pivot (their
+    # stiffnesses add). Without it a place on its context's pivot (two "past" springs, development office seed 16)
+    # shook there at 0.13 m/s and its settle never ended
+    angle_core_wdt: float = 1.0
     # m, l of an angle spring with no distance spring between its places: its force K * error * l / r is the
     # paper's K * error at r = l (forces.py)
     angle_length: float = 1.0
@@ -93,8 +99,9 @@ class DynamicsParams:
     # s, integration step (the paper: Runge-Kutta at 0.1; here pymunk's semi-implicit Euler). A settle lasts as
     # long in model time whatever the step (friction takes e-fold 2 m / c = 20 s off an oscillation), so the
     # step sets how many steps it costs. Semi-implicit Euler is stable while w dt < 2; the stiffest spring the
-    # model makes is an angle spring at its core, K l / (share l)^2 = 40 N/m for a label (K 2.5, l 1 m), so
-    # w = 6.3 rad/s and w dt = 1.26 at 0.2 s (1.9 at 0.3). On generated campuses (500 places, development
+    # model makes is an angle spring at its core, held to w dt <= angle_core_wdt (1) by the core's floor whatever
+    # the step (a label's floor is then 0.99 m at 0.2 s, 0.5 m at 0.1 s; the floor grows with the step, so a
+    # longer step blurs angles near their pivots instead of shaking). On generated campuses (500 places, development
     # seeds 0 and 1, 360 cues) positions after every settle agree with 0.1 s to a median of 0.0 m and a 90th
     # percentile of 0.6-0.8 m, within Algorithm 1's own tolerance (a place held at 0.01 N/m may stop 10 m from
     # its rest), as many settles converge, and a settle takes half the steps
@@ -103,11 +110,17 @@ class DynamicsParams:
     settle_velocity: float = 0.1  # m/s, L_v
     max_iterations: int = 5000  # steps before settle() gives up and reports "not settled"
 
+    @property
+    def core(self) -> Core:
+        """Where the angle springs' energy fades round their pivots (forces.py)."""
+        steep = math.pi * self.dt / (self.angle_core_wdt * math.sqrt(self.mass))  # m per sqrt(N m/rad)
+        return Core(self.angle_core, self.angle_core_share, steep)
+
     def __post_init__(self) -> None:
         _choice("DynamicsParams.expansion_law", self.expansion_law, tuple(EXPANSION_LAWS))
         _choice("DynamicsParams.expansion_on", self.expansion_on, ("leaves", "all"))
         for name in ("mass", "settle_acceleration", "settle_velocity", "angle_length", "wake_acceleration",
-                     "angle_core"):
+                     "angle_core", "angle_core_wdt"):
             _positive(f"DynamicsParams.{name}", getattr(self, name))
         _positive("DynamicsParams.dt", self.dt, high=10.0)
         if isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int):

@@ -36,7 +36,7 @@ _KEYS = ("format", "params", "hierarchy", "start", "start_roots", "goal", "fixed
 # "settled_moving": null, or the places left moving when the model is saved just as its last settle left it
 _FIXED_KEYS = ("kind", "x", "y", "theta", "sightings", "text")
 # dynamics parameters older files lack (they load with the defaults)
-_NEW_DYNAMICS = ("angle_length", "angle_core_share", "wake_acceleration", "solver_iterations")
+_NEW_DYNAMICS = ("angle_length", "angle_core_share", "wake_acceleration", "solver_iterations", "angle_core_wdt")
 # dynamics parameters older files have that no longer exist, and what replaced them
 _RETIRED_DYNAMICS = {"angle_law": "angle springs follow the potential law, the force of K l error^2 / 2"}
 

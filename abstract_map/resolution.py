@@ -27,7 +27,7 @@ from scipy.sparse.csgraph import connected_components
 
 from .clauses import Clause, is_anchor
 from .dynamics import SpringIndex, pair
-from .forces import ANGLE_KINDS, NetForce
+from .forces import ANGLE_KINDS, Core, NetForce
 from .params import ScaleDefaults
 from .placement import Resolved
 from .scales import LEARNABLE, ScaleKey, default_scale, learn_scales, scale_key
@@ -268,7 +268,7 @@ class SpringField:
         self._arrays = kind, rows, value, stiffness, np.concatenate([lengths, tail_lengths])
 
     def around(self, names: Sequence[str], *, expand: Sequence[bool], centre: complex | None, expansion: float,
-               law: str, core: float, share: float) -> NetForce:
+               law: str, core: Core) -> NetForce:
         """The net force on ``names`` from every spring touching them (and the expansion force)."""
         kind, rows, value, stiffness, length = self._arrays
         fixed, tail = self._parts
@@ -287,4 +287,4 @@ class SpringField:
         slots = list(names) + [self._names[i] for i in others.tolist()]
         return NetForce.of_arrays(names, slots, kind[chosen], lookup[sub], value[chosen], stiffness[chosen],
                                   length[chosen], expand=expand, centre=centre, expansion=expansion, law=law,
-                                  core=core, share=share)
+                                  core=core)

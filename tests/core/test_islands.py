@@ -29,7 +29,7 @@ def net_forces(model: AbstractMap) -> dict[str, float]:
                                               for s in springs],
                       expand=[n not in parents for n in names],
                       centre=complex(*model.explored_centre), expansion=params.expansion,
-                      law=params.expansion_law, core=params.angle_core, share=params.angle_core_share)
+                      law=params.expansion_law, core=params.core)
     return dict(zip(names, np.abs(force)))
 
 
@@ -116,6 +116,19 @@ def test_angle_springs_settle_where_the_potential_law_puts_them():
     x, y = result.positions["A"]
     assert math.degrees(math.atan2(y, x)) == pytest.approx(90.0, abs=3.0) and math.hypot(x, y) == pytest.approx(4.0,
                                                                                                                abs=0.3)
+
+
+def test_two_signs_that_disagree_settle_with_the_place_at_the_nearer_ones_pivot():
+    # both signs point the place 5.3 m north; the second stands 12.8 m north of the first. Their distance springs
+    # pull the place south of the second sign, whose angle spring then pushes it round: the least energy is at
+    # that sign. Inside an angle spring's core its force is the gradient of an energy, so the place comes to rest
+    # there (a force held at its value instead kept it circling the sign, never settled; office seed 4)
+    springs = [Resolved("distance", ("A", "#1"), 5.3, 0.1), Resolved("global_angle", ("#1", "A"), math.pi / 2, 0.5),
+               Resolved("distance", ("A", "#2"), 5.3, 0.1), Resolved("global_angle", ("#2", "A"), math.pi / 2, 0.5)]
+    result = integrate({"A": np.array([0.0, 5.3])}, {}, {"#1": np.array([0.0, 0.0]), "#2": np.array([0.0, 12.8])},
+                       springs, active=["A"], expand=[], centre=None, params=DynamicsParams())
+    assert result.settled
+    assert math.dist(result.positions["A"], (0.0, 12.8)) < 0.5
 
 
 def test_a_refused_settle_leaves_the_next_one_to_count_each_spring_once(monkeypatch):

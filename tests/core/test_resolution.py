@@ -105,17 +105,17 @@ def test_the_spring_field_gives_each_mass_the_net_force_its_own_springs_give():
     around = [s for s in index.around(names) for _ in range(index.count[s])]
     expected = forces_on(names, around, where, [index.length(s, params.angle_length) for s in around],
                          expand=[False] * len(names), centre=None, expansion=0.0, law="constant",
-                         core=params.angle_core, share=params.angle_core_share)
+                         core=params.core)
     field = SpringField()
     field.prepare(model._cached("clause springs", model._springs_of_clauses), springs, index, params.angle_length)
     net = field.around(names, expand=[False] * len(names), centre=None, expansion=0.0, law="constant",
-                       core=params.angle_core, share=params.angle_core_share)
+                       core=params.core)
     got = net(np.array([where[n] for n in net.slots], dtype=complex))
     assert np.median(np.abs(expected)) > 0.01  # not at rest: the comparison means something
     assert np.allclose(got, expected, rtol=1e-9, atol=1e-12)
     some = names[::7]
     net = field.around(some, expand=[False] * len(some), centre=None, expansion=0.0, law="constant",
-                       core=params.angle_core, share=params.angle_core_share)
+                       core=params.core)
     assert np.allclose(net(np.array([where[n] for n in net.slots], dtype=complex)), expected[::7], rtol=1e-9,
                        atol=1e-12)
 
