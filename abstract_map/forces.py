@@ -8,8 +8,9 @@ newtons, complex likewise.
   ``K l error / r`` at distance ``r`` from its pivot, the pivot taking the
   reaction; ``l`` is the natural length of the stiffest distance spring
   between the pivot and the place it turns (so at ``r = l`` the force is the
-  paper's ``K * error``). Nearer the pivot than the floor ``f = max(core,
-  share * l)``, where the direction is ill-defined, the energy fades as
+  paper's ``K * error``). Nearer the pivot than the floor ``f`` (:class:`Core`:
+  at least so far that the steepest pull keeps the integrator stable),
+  where the direction is ill-defined, the energy fades as
   ``(r / f)^2`` (a relative spring's by the product of its two pairs' fades),
   and the force is still its gradient: tangential ``K l error r / f^2`` and
   a pull toward the pivot of ``K l error^2 r / f^2``, bounded, nothing at the
