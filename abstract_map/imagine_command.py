@@ -36,7 +36,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--plot", type=Path, help="also draw the final imagined map to this PNG")
     parser.add_argument("--save-model", type=Path, help="also save the final model (versioned JSON)")
     parser.add_argument("--max-steps", type=int, help="cap each settle at this many steps (default: the model's "
-                        "max_iterations, 5000)")
+                        "max_iterations, 50,000)")
     parser.add_argument("--max-s", type=float, help="cap each settle at this many seconds of wall time (default: "
                         "none)")
     parser.add_argument("--quiet", action="store_true", help="no progress lines")

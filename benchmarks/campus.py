@@ -14,12 +14,13 @@ buildings > wings > rooms. Every cue comes from the true geometry:
 
 The robot walks the buildings in order, reading each building's sign, then
 each wing's sign and its labels. Reported: median and p95 settle per cue (CPU
-and wall), how many settles converged, peak memory (the process's maximum
+and wall), how many settles converged (and the first 50 cues whose settle
+stopped at a cap), peak memory (the process's maximum
 resident set), and the imagined-position error of places a sign has named but
 whose label has not been read, after every settle (to the nearest cm), against their truth and
 against guessing each at the sign that first named it.
 
-    python benchmarks/campus.py 500 [--cues N] [--seed S] [--json]
+    python benchmarks/campus.py 500 [--cues N] [--seed S] [--max-steps N] [--max-seconds S] [--json]
 """
 
 from __future__ import annotations
@@ -146,8 +147,10 @@ class Histogram:
         return (middle + 0.5) * self.BIN_M
 
 
-def walk(campus: Campus, *, max_cues: int | None = None, max_seconds: float | None = None) -> dict:
-    """Feed the cues one at a time, settling after each; the figures of the benchmark."""
+def walk(campus: Campus, *, max_cues: int | None = None, max_seconds: float | None = None,
+         max_steps: int | None = None) -> dict:
+    """Feed the cues one at a time, settling after each (capped at ``max_steps`` steps and ``max_seconds``
+    of wall time per settle when given); the figures of the benchmark."""
     from abstract_map.clauses import Locational
     from abstract_map.hierarchy import Hierarchy
     from abstract_map.model import AbstractMap
@@ -155,11 +158,13 @@ def walk(campus: Campus, *, max_cues: int | None = None, max_seconds: float | No
     model = AbstractMap.from_hierarchy(Hierarchy.from_nested(campus.tree), campus.start)
     visited = np.array(campus.start[:2])
     model.set_explored_centre(visited)
-    caps_kw = {} if max_seconds is None else {"max_s": max_seconds}  # older checkouts have no per-call caps
+    caps_kw = {k: v for k, v in (("max_s", max_seconds), ("max_steps", max_steps)) if v is not None}
+    # (older checkouts have no per-call caps: nothing is passed unless asked for)
     cpu0, wall0 = time.process_time(), time.perf_counter()
     model.settle(**caps_kw)
     first = (time.process_time() - cpu0, time.perf_counter() - wall0)
     cpu, wall, steps, moved, converged, caps = [], [], [], [], 0, {"steps": 0, "time": 0}
+    capped_at: list[int] = []  # the cues (1 = the first) whose settle stopped at a cap
     named_at: dict[str, np.ndarray] = {}  # place -> the sign that first named it
     seen: set[str] = set()
     errors, guesses = Histogram(), Histogram()
@@ -178,6 +183,7 @@ def walk(campus: Campus, *, max_cues: int | None = None, max_seconds: float | No
         cap = getattr(report, "stopped_by", "" if report.settled else "steps")
         if cap:
             caps[cap] += 1
+            capped_at.append(i)
         for clause in observation.clauses:
             if isinstance(clause, Locational) and clause.kind == "label":
                 seen.add(clause.toponym)
@@ -200,8 +206,9 @@ def walk(campus: Campus, *, max_cues: int | None = None, max_seconds: float | No
         "of_cues": len(campus.cues), "first_settle_cpu_s": first[0], "first_settle_wall_s": first[1],
         "median_cpu_ms": 1000 * statistics.median(cpu), "p95_cpu_ms": 1000 * float(np.percentile(cpu, 95)),
         "median_wall_ms": 1000 * statistics.median(wall), "p95_wall_ms": 1000 * float(np.percentile(wall, 95)),
-        "median_steps": statistics.median(steps), "median_moved": statistics.median(moved),
-        "converged": converged, "caps": caps,
+        "max_cpu_ms": 1000 * max(cpu, default=math.nan),
+        "median_steps": statistics.median(steps), "max_steps": max(steps, default=0), "median_moved": statistics.median(moved),
+        "converged": converged, "caps": caps, "capped_cues": capped_at[:50],
         "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
         "error_median_m": errors.median(), "guess_median_m": guesses.median(),
         "errors_counted": errors.count, "module": sys.modules["abstract_map"].__file__,
@@ -214,9 +221,16 @@ def main() -> int:
     parser.add_argument("--cues", type=int, default=None, help="stop after this many cues (default: the whole walk)")
     parser.add_argument("--seed", type=int, default=0, help="campus jitter seed (development seeds 0-999)")
     parser.add_argument("--max-seconds", type=float, default=None, help="wall-time cap per settle")
+    parser.add_argument("--max-steps", type=int, default=None,
+                        help="step cap per settle (default: the model's DynamicsParams.max_iterations, 50,000)")
     parser.add_argument("--json", action="store_true", help="print one JSON line")
     args = parser.parse_args()
-    figures = walk(generate(args.places, args.seed), max_cues=args.cues, max_seconds=args.max_seconds)
+    if args.max_steps is not None and args.max_steps < 1:
+        parser.error(f"--max-steps must be a whole number of steps >= 1, got {args.max_steps}")
+    if args.max_seconds is not None and not args.max_seconds > 0:
+        parser.error(f"--max-seconds must be a number of seconds > 0, got {args.max_seconds}")
+    figures = walk(generate(args.places, args.seed), max_cues=args.cues, max_seconds=args.max_seconds,
+                   max_steps=args.max_steps)
     print(json.dumps(figures) if args.json else "\n".join(f"{k}: {v}" for k, v in figures.items()))
     return 0
 
