@@ -226,10 +226,15 @@ def main() -> int:
                         help="step cap per settle (default: the model's DynamicsParams.max_iterations, 50,000)")
     parser.add_argument("--json", action="store_true", help="print one JSON line")
     args = parser.parse_args()
-    if args.max_steps is not None and args.max_steps < 1:
-        parser.error(f"--max-steps must be a whole number of steps >= 1, got {args.max_steps}")
-    if args.max_seconds is not None and not args.max_seconds > 0:
-        parser.error(f"--max-seconds must be a number of seconds > 0, got {args.max_seconds}")
+    if args.max_steps is not None or args.max_seconds is not None:  # older checkouts have no per-call caps
+        from abstract_map.errors import AbstractMapError
+        from abstract_map.model import settle_caps
+
+        try:
+            settle_caps(args.max_steps, args.max_seconds, names=("--max-steps", "--max-seconds"),
+                        error=AbstractMapError)
+        except AbstractMapError as error:
+            parser.error(str(error))
     figures = walk(generate(args.places, args.seed), max_cues=args.cues, max_seconds=args.max_seconds,
                    max_steps=args.max_steps)
     print(json.dumps(figures) if args.json else "\n".join(f"{k}: {v}" for k, v in figures.items()))
