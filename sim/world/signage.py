@@ -3,7 +3,8 @@
 Signs hang at the entrance (on the entrance corridor's wall) and at every
 junction of three or more corridors, facing the way a visitor from the
 entrance arrives: on the far wall of a T, or on the corner across the junction
-otherwise. Each names, by arrow, the goals (or their areas) whose routes pass
+otherwise, always where the junction's centre sees the sign's reader (never on
+a wall of a room behind the junction's own walls). Each names, by arrow, the goals (or their areas) whose routes pass
 the junction, then a few more areas, wings, halls and rooms; an arrow is
 written only when ``truth`` puts it well within the tolerance (``slack``). Each
 sign also carries phrases (past, before, left of, right of, near, between) that
@@ -78,6 +79,17 @@ def _wall_ok(plan: Floorplan, x: float, y: float, theta: float) -> bool:
 MIN_TAG_GAP_M = 0.6  # m, centre to centre: two tags (0.375 m wide with their quiet zones) never overlap
 
 
+def _in_sight(plan: Floorplan, a: tuple[float, float] | np.ndarray, b: tuple[float, float] | np.ndarray) -> bool:
+    """Whether the segment from ``a`` to ``b`` (m) crosses no wall of ``plan`` (sampled every half pixel): a
+    junction's sign is read from where the junction's centre can see, not from a room behind its wall."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    n = max(2, int(math.ceil(float(np.hypot(*(b - a))) / (0.5 * plan.resolution))) + 1)
+    rc = plan.world_to_pixel(a + np.linspace(0.0, 1.0, n)[:, None] * (b - a))
+    rows, cols = plan.occupied.shape
+    inside = (rc[:, 0] >= 0) & (rc[:, 0] < rows) & (rc[:, 1] >= 0) & (rc[:, 1] < cols)
+    return bool(inside.all() and not plan.occupied[rc[:, 0], rc[:, 1]].any())
+
+
 def sign_spots(layout: Layout, plan: Floorplan, routes: Routes, labels: list[Tag]) -> list[SignSpot]:
     """The entrance sign and one sign per junction (three or more corridors), where a wall takes them.
 
@@ -88,8 +100,10 @@ def sign_spots(layout: Layout, plan: Floorplan, routes: Routes, labels: list[Tag
 
     def fits(spot: SignSpot) -> bool:
         clear = len(taken) == 0 or float(np.hypot(*(taken - [spot.x, spot.y]).T).min()) >= MIN_TAG_GAP_M
-        return clear and _wall_ok(plan, spot.x, spot.y, spot.theta) and \
-            routes.reading_pose(_tag(spot, plan)) is not None
+        if not (clear and _wall_ok(plan, spot.x, spot.y, spot.theta)):
+            return False
+        pose = routes.reading_pose(_tag(spot, plan))
+        return pose is not None and (spot.node is None or _in_sight(plan, layout.node_xy(spot.node), pose))
 
     g = layout.graph
     entrance_node = min(layout.entrance)  # the end on the outer wall

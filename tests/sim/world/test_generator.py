@@ -124,6 +124,26 @@ def test_signage_levels_share_the_building():
     assert report.ok and {(int(f.subject.split()[1])) for f in declared} == {m["tag"] for m in misleading.misleading}
 
 
+def test_every_junction_sign_is_read_from_its_junction():
+    """A junction's sign hangs where the junction's centre sees its reader, never in a room behind its wall
+    (office seed 3 once hung one south of a T's crossing wall, read only from the room below)."""
+    from sim.world.signage import _in_sight
+    from sim.world.truth import Routes, TruthParams
+
+    for style in ("office", "museum"):
+        g = made(3, style, "medium")
+        layout, plan = g.layout, g.world.floorplan
+        routes = Routes(plan, TruthParams())
+        junctions = [layout.node_xy(n) for n in layout.graph.nodes if layout.graph.degree(n) >= 3]
+        start = np.array(g.world.start[:2])
+        for tag in g.world.tags.values():
+            if tag.kind != "sign" or math.dist((tag.x, tag.y), start) < 6.0:  # the entrance's sign
+                continue
+            pose = routes.reading_pose(tag)
+            assert pose is not None and any(math.dist(j, pose) < 6.0 and _in_sight(plan, j, pose)
+                                            for j in junctions), f"{style}: sign {tag.id} hidden from its junction"
+
+
 def test_one_metre_doors_pass_the_oracles_inflation():
     for cell in (0.05, 0.1):
         occupied = np.ones((60, 60), dtype=bool)
