@@ -4,10 +4,10 @@ Signs hang at the entrance (on the entrance corridor's wall) and at every
 junction of three or more corridors, facing the way a visitor from the
 entrance arrives: on the far wall of a T, or on the corner across the junction
 otherwise, always where the junction's centre sees the sign's reader (never on
-a wall of a room behind the junction's own walls). Each names, by arrow, the goals (or their areas) whose routes pass
-the junction, then a few more areas, wings, halls and rooms; an arrow is
-written only when ``truth`` puts it well within the tolerance (``slack``). Each
-sign also carries phrases (past, before, left of, right of, near, between) that
+a wall of a room behind the junction's own walls). Each names, by arrow, the
+goals (or their areas) whose routes pass the junction, then a few more areas,
+wings, halls and rooms; an arrow is written only when ``truth`` puts it well
+within the tolerance (``slack``). Each sign also carries phrases (past, before, left of, right of, near, between) that
 ``truth`` calls true with the same slack, and an "X is in Y" line.
 """
 
@@ -79,7 +79,7 @@ def _wall_ok(plan: Floorplan, x: float, y: float, theta: float) -> bool:
 MIN_TAG_GAP_M = 0.6  # m, centre to centre: two tags (0.375 m wide with their quiet zones) never overlap
 
 
-def _in_sight(plan: Floorplan, a: tuple[float, float] | np.ndarray, b: tuple[float, float] | np.ndarray) -> bool:
+def in_sight(plan: Floorplan, a: tuple[float, float] | np.ndarray, b: tuple[float, float] | np.ndarray) -> bool:
     """Whether the segment from ``a`` to ``b`` (m) crosses no wall of ``plan`` (sampled every half pixel): a
     junction's sign is read from where the junction's centre can see, not from a room behind its wall."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
@@ -103,7 +103,7 @@ def sign_spots(layout: Layout, plan: Floorplan, routes: Routes, labels: list[Tag
         if not (clear and _wall_ok(plan, spot.x, spot.y, spot.theta)):
             return False
         pose = routes.reading_pose(_tag(spot, plan))
-        return pose is not None and (spot.node is None or _in_sight(plan, layout.node_xy(spot.node), pose))
+        return pose is not None and (spot.node is None or in_sight(plan, layout.node_xy(spot.node), pose))
 
     g = layout.graph
     entrance_node = min(layout.entrance)  # the end on the outer wall

@@ -127,7 +127,7 @@ def test_signage_levels_share_the_building():
 def test_every_junction_sign_is_read_from_its_junction():
     """A junction's sign hangs where the junction's centre sees its reader, never in a room behind its wall
     (office seed 3 once hung one south of a T's crossing wall, read only from the room below)."""
-    from sim.world.signage import _in_sight
+    from sim.world.signage import in_sight
     from sim.world.truth import Routes, TruthParams
 
     for style in ("office", "museum"):
@@ -140,7 +140,7 @@ def test_every_junction_sign_is_read_from_its_junction():
             if tag.kind != "sign" or math.dist((tag.x, tag.y), start) < 6.0:  # the entrance's sign
                 continue
             pose = routes.reading_pose(tag)
-            assert pose is not None and any(math.dist(j, pose) < 6.0 and _in_sight(plan, j, pose)
+            assert pose is not None and any(math.dist(j, pose) < 6.0 and in_sight(plan, j, pose)
                                             for j in junctions), f"{style}: sign {tag.id} hidden from its junction"
 
 
