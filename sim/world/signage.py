@@ -7,8 +7,9 @@ otherwise, always where the junction's centre sees the sign's reader (never on
 a wall of a room behind the junction's own walls). Each names, by arrow, the
 goals (or their areas) whose routes pass the junction, then a few more areas,
 wings, halls and rooms; an arrow is written only when ``truth`` puts it well
-within the tolerance (``slack``). Each sign also carries phrases (past, before, left of, right of, near, between) that
-``truth`` calls true with the same slack, and an "X is in Y" line.
+within the tolerance (``slack``). Each sign also carries phrases (past,
+before, left of, right of, near, between) that ``truth`` calls true with the
+same slack, and an "X is in Y" line.
 """
 
 from __future__ import annotations
