@@ -58,7 +58,7 @@ class RouteParams:
     area_wrong_prob: float = 0.35  # for an arrow naming an area holding the goal: the goal may lie off the
     # area's route (a wing's arrow leads to its nearest room, not to every room of it)
     named_prob: float = 0.7  # chance that a sign on the goal's route names it or an area holding it: the generator's
-    # complete signage names 171 of 172 (worlds/README.md), its sparse signage half by area only; hand-made
+    # complete signage names all 159 of seeds 0-4 (worlds/README.md), its sparse signage half by area only; hand-made
     # buildings name fewer (the zoo's signs list a few places each)
     junction_m: float = 2.0  # m from a sign's reader within which a route counts as passing the sign (a junction
     # of corridors up to 3 m wide)
