@@ -159,6 +159,15 @@ class Floorplan:
         row = rows - 1 - np.floor((xy[:, 1] - self.origin[1]) / self.resolution).astype(int)
         return np.stack([row, col], axis=1)
 
+    def wall_at(self, xy: np.ndarray) -> np.ndarray:
+        """Per world point (N, 2, m): whether it falls on an obstacle pixel; outside the image counts as wall."""
+        rc = self.world_to_pixel(xy)
+        rows, cols = self.occupied.shape
+        inside = (rc[:, 0] >= 0) & (rc[:, 0] < rows) & (rc[:, 1] >= 0) & (rc[:, 1] < cols)
+        out = np.ones(len(rc), dtype=bool)
+        out[inside] = self.occupied[rc[inside, 0], rc[inside, 1]]
+        return out
+
     def pixel_to_world(self, rc: np.ndarray) -> np.ndarray:
         """Pixel (row, col) indices (N, 2) to the world positions (m) of their centres."""
         rc = np.atleast_2d(np.asarray(rc, dtype=float))

@@ -65,16 +65,7 @@ def _wall_ok(plan: Floorplan, x: float, y: float, theta: float) -> bool:
     offsets = np.linspace(-0.25, 0.25, 11)
     behind = origin - (TAG_FRONT_M + 0.05) * n + offsets[:, None] * t
     front = origin + 0.3 * n + offsets[:, None] * t
-    rows, cols = plan.occupied.shape
-
-    def occ(points: np.ndarray) -> np.ndarray:
-        rc = plan.world_to_pixel(points)
-        inside = (rc[:, 0] >= 0) & (rc[:, 0] < rows) & (rc[:, 1] >= 0) & (rc[:, 1] < cols)
-        out = np.ones(len(points), dtype=bool)
-        out[inside] = plan.occupied[rc[inside, 0], rc[inside, 1]]
-        return out
-
-    return bool(occ(behind).all() and not occ(front).any())
+    return bool(plan.wall_at(behind).all() and not plan.wall_at(front).any())
 
 
 MIN_TAG_GAP_M = 0.6  # m, centre to centre: two tags (0.375 m wide with their quiet zones) never overlap
@@ -85,10 +76,7 @@ def in_sight(plan: Floorplan, a: tuple[float, float] | np.ndarray, b: tuple[floa
     junction's sign is read from where the junction's centre can see, not from a room behind its wall."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     n = max(2, int(math.ceil(float(np.hypot(*(b - a))) / (0.5 * plan.resolution))) + 1)
-    rc = plan.world_to_pixel(a + np.linspace(0.0, 1.0, n)[:, None] * (b - a))
-    rows, cols = plan.occupied.shape
-    inside = (rc[:, 0] >= 0) & (rc[:, 0] < rows) & (rc[:, 1] >= 0) & (rc[:, 1] < cols)
-    return bool(inside.all() and not plan.occupied[rc[:, 0], rc[:, 1]].any())
+    return not bool(plan.wall_at(a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)).any())
 
 
 def sign_spots(layout: Layout, plan: Floorplan, routes: Routes, labels: list[Tag]) -> list[SignSpot]:

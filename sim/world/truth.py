@@ -75,15 +75,6 @@ WALL_SNAP_M = 0.2  # m, the scene's tag_through_m and tag_snap_m: how far a tag 
 TAG_GAP_M = 0.02  # m, the scene's tag_wall_gap_m: a tag's face in front of its wall
 
 
-def _occupied(plan: Floorplan, points: np.ndarray) -> np.ndarray:
-    rc = plan.world_to_pixel(points)
-    rows, cols = plan.occupied.shape
-    inside = (rc[:, 0] >= 0) & (rc[:, 0] < rows) & (rc[:, 1] >= 0) & (rc[:, 1] < cols)
-    out = np.ones(len(points), dtype=bool)  # outside the plan counts as wall
-    out[inside] = plan.occupied[rc[inside, 0], rc[inside, 1]]
-    return out
-
-
 def hang(plan: Floorplan, tag: Tag) -> tuple[Tag, str | None]:
     """Where ``tag`` hangs, by the scene's rule on the floor plan, and what is wrong if it has no wall.
 
@@ -97,7 +88,7 @@ def hang(plan: Floorplan, tag: Tag) -> tuple[Tag, str | None]:
     origin = np.array([tag.x, tag.y])
     step = min(0.01, plan.resolution / 2)
     ahead = np.arange(0.0, 2 * WALL_SNAP_M + step, step)
-    occ = _occupied(plan, origin + ahead[:, None] * n)
+    occ = plan.wall_at(origin + ahead[:, None] * n)
     face: float | None = None
     starts = np.nonzero(occ & (ahead <= WALL_SNAP_M))[0]
     if len(starts):
@@ -108,7 +99,7 @@ def hang(plan: Floorplan, tag: Tag) -> tuple[Tag, str | None]:
             return tag, f"inside a wall: no free face within {WALL_SNAP_M} m in front of it"
     if face is None:
         behind = np.arange(step, WALL_SNAP_M + step, step)
-        hits = np.nonzero(_occupied(plan, origin - behind[:, None] * n))[0]
+        hits = np.nonzero(plan.wall_at(origin - behind[:, None] * n))[0]
         if len(hits) == 0:
             return tag, f"no wall within {WALL_SNAP_M} m behind it (it stands free)"
         face = -float(behind[hits[0]]) + step
