@@ -54,6 +54,8 @@ class RouteParams:
     tolerance_deg: float = 45.0  # deg a first leg may lie off its arrow (the convention's, as `world check`)
     spread_deg: float = 20.0  # deg beyond the tolerance that divide the likelihood by e: an 8-connected path
     # may take its diagonal steps first, so a first leg read off the grid can lie up to 22.5 deg off its line
+    unseen_detour: float = 0.41  # share of a route's length across unseen space by which the true route may be
+    # longer: round a square block rather than across its diagonal (sqrt 2 - 1); see route_likelihood
     wrong_prob: float = 0.1  # chance an arrow naming the goal is wrong ("misleading" signage: one in ten)
     area_wrong_prob: float = 0.35  # for an arrow naming an area holding the goal: the goal may lie off the
     # area's route (a wing's arrow leads to its nearest room, not to every room of it)
@@ -93,21 +95,26 @@ class PathSearches:
     that grid changed (walls are mapped slowly, so the coarse grids often stay the same for a while)."""
 
     costs: dict[str, np.ndarray] = field(default_factory=dict)  # the cost grid of each kind of search
-    found: dict[tuple[str, tuple[int, int]], tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
-    # (kind, start) -> lengths and scikit-image's traceback (an index into _OFFSETS per cell)
+    found: dict[tuple[str, tuple], tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+    # (kind, start or starts) -> lengths and scikit-image's traceback (an index into _OFFSETS per cell)
     parents: dict[tuple[str, tuple[int, int]], np.ndarray] = field(default_factory=dict)  # worked out when asked
 
     def lengths(self, kind: str, costs: np.ndarray, start: tuple[int, int]) -> np.ndarray:
         """Cumulative cost (in cells of ``costs``) from ``start`` to every cell of ``costs`` (inf: cut off), by
         scikit-image's minimum-cost path, 8-connected."""
+        return self.lengths_from(kind, costs, (start,))
+
+    def lengths_from(self, kind: str, costs: np.ndarray, starts: tuple[tuple[int, int], ...]) -> np.ndarray:
+        """:meth:`lengths` from the nearest of several ``starts`` (each at cost 0)."""
         known = self.costs.get(kind)
         if known is None or known.shape != costs.shape or not np.array_equal(known, costs):
             self.costs[kind] = costs.copy()
             self.found = {key: value for key, value in self.found.items() if key[0] != kind}
             self.parents = {key: value for key, value in self.parents.items() if key[0] != kind}
-        if (kind, start) not in self.found:
-            self.found[kind, start] = MCP_Geometric(costs, fully_connected=True).find_costs([start])
-        return self.found[kind, start][0]
+        key = (kind, starts[0] if len(starts) == 1 else starts)
+        if key not in self.found:
+            self.found[key] = MCP_Geometric(costs, fully_connected=True).find_costs(list(starts))
+        return self.found[key][0]
 
     def tree(self, kind: str, costs: np.ndarray, start: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`lengths`, and each cell's predecessor on its shortest path from ``start`` (flat index into
@@ -154,6 +161,7 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
     pool, blocked = route_cells(grid, params)
     costs = np.where(blocked, np.inf, 1.0)
     step = pool * grid.resolution
+    unseen = pool_cells(grid.unknown_mask().astype(np.float32), pool, np.float32(1.0), np.mean) > 0.5
     total = np.ones(blocked.shape)
     tolerance, spread = math.radians(params.tolerance_deg), math.radians(params.spread_deg)
     for arrow in arrows:
@@ -163,16 +171,61 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
         if stand is None:
             continue
         lengths, pred = searches.tree("route", costs, stand)
-        leg = first_leg_points(lengths.ravel(), pred, params.lead_m / step)
+        lead = params.lead_m / step
+        leg = first_leg_points(lengths.ravel(), pred, lead)
         rows, cols = np.divmod(leg, blocked.shape[1])
         heading = np.arctan2(-(rows - stand[0]), cols - stand[1])  # rows run down the map: y is -row
         error = np.abs(np.angle(np.exp(1j * (heading - arrow.direction))))
         near = np.exp(-np.maximum(error - tolerance, 0.0) / spread).reshape(blocked.shape)
+        if params.unseen_detour > 0:
+            near = np.maximum(near, _unseen_way(lengths, pred, error.reshape(blocked.shape) <= tolerance, costs,
+                                                unseen, lead, params.unseen_detour, searches, f"leg {arrow}"))
         near[~np.isfinite(lengths)] = 1.0  # cut off from the reader: the arrow says nothing there
         near[stand] = 1.0
         total *= arrow.wrong_prob + (1.0 - arrow.wrong_prob) * near
     fine = unpool_cells(total, pool, grid.shape)
     return fine / float(fine.max())
+
+
+def _unseen_way(lengths: np.ndarray, pred: np.ndarray, along: np.ndarray, costs: np.ndarray, unseen: np.ndarray,
+                lead: float, share: float, searches: PathSearches, kind: str) -> np.ndarray:
+    """Per route cell, how likely its true route from the reader sets off along the arrow although its shortest
+    route over the robot's map does not: ``exp(-detour / (share * across))``, with ``detour`` how much longer (in
+    cells) the shortest route is that leaves the reader's circle of ``lead`` cells where the arrow points
+    (``along``: each cell's first leg lies within the tolerance; the route may not come back through the circle)
+    and ``across`` the cells of the shortest route that lie in ``unseen`` space. A route over mapped space is what
+    it is (0 where ``across`` is 0); one across unseen space may be longer in truth by up to ``share`` of that.
+    Cells within the circle get 0: their first leg is the test."""
+    flat = lengths.ravel()
+    inside = flat <= lead
+    rim = inside & (flat > lead - 1.5) & along.ravel()
+    if not rim.any():
+        return np.zeros(lengths.shape)
+    held = costs.copy().ravel()
+    held[inside & ~rim] = np.inf
+    starts = tuple(tuple(int(v) for v in divmod(int(i), lengths.shape[1])) for i in np.flatnonzero(rim))
+    with np.errstate(invalid="ignore"):
+        detour = searches.lengths_from(kind, held.reshape(lengths.shape), starts) + lead - lengths
+    across = share * path_sums(pred, np.where(unseen.ravel(), 1.0, 0.0)).reshape(lengths.shape)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out = np.where((across > 0) & np.isfinite(detour), np.exp(-np.maximum(detour, 0.0) / across), 0.0)
+    out.ravel()[inside] = 0.0
+    return out
+
+
+def path_sums(pred: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Per index, the sum of ``values`` over it and its ancestors by ``pred`` (an index per index; a root points
+    to itself and counts 0). By pointer jumping: each round doubles how far back a sum reaches."""
+    own = np.arange(len(pred))
+    acc = np.where(pred == own, 0.0, values)
+    jump = pred
+    for _ in range(64):
+        nxt = jump[jump]
+        acc = acc + acc[jump]
+        if np.array_equal(nxt, jump):
+            return acc
+        jump = nxt
+    raise ValueError("path_sums: the pointers form a cycle")
 
 
 def passed_likelihood(grid: OccupancyGrid, readers: Iterable[tuple[float, float]], start_xy: np.ndarray,
