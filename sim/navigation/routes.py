@@ -56,6 +56,8 @@ class RouteParams:
     # may take its diagonal steps first, so a first leg read off the grid can lie up to 22.5 deg off its line
     unseen_detour: float = 0.41  # share of a route's length across unseen space by which the true route may be
     # longer: round a square block rather than across its diagonal (sqrt 2 - 1); see route_likelihood
+    unseen_reach_m: float = 15.0  # m from the reader within which unseen space can turn a route's first leg: the
+    # walls of about one block between corridors (10-20 m in most buildings)
     wrong_prob: float = 0.1  # chance an arrow naming the goal is wrong ("misleading" signage: one in ten)
     area_wrong_prob: float = 0.35  # for an arrow naming an area holding the goal: the goal may lie off the
     # area's route (a wing's arrow leads to its nearest room, not to every room of it)
@@ -179,7 +181,8 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
         near = np.exp(-np.maximum(error - tolerance, 0.0) / spread).reshape(blocked.shape)
         if params.unseen_detour > 0:
             near = np.maximum(near, _unseen_way(lengths, pred, error.reshape(blocked.shape) <= tolerance, costs,
-                                                unseen, lead, params.unseen_detour, searches, f"leg {arrow}"))
+                                                unseen & (lengths <= params.unseen_reach_m / step), lead,
+                                                params.unseen_detour, searches, f"leg {arrow}"))
         near[~np.isfinite(lengths)] = 1.0  # cut off from the reader: the arrow says nothing there
         near[stand] = 1.0
         total *= arrow.wrong_prob + (1.0 - arrow.wrong_prob) * near
@@ -193,20 +196,21 @@ def _unseen_way(lengths: np.ndarray, pred: np.ndarray, along: np.ndarray, costs:
     route over the robot's map does not: ``exp(-detour / (share * across))``, with ``detour`` how much longer (in
     cells) the shortest route is that leaves the reader's circle of ``lead`` cells where the arrow points
     (``along``: each cell's first leg lies within the tolerance; the route may not come back through the circle)
-    and ``across`` the cells of the shortest route that lie in ``unseen`` space. A route over mapped space is what
+    and ``across`` the cells of the shortest route that lie in ``unseen`` space (those near enough the reader to
+    turn its first leg). A route over mapped space is what
     it is (0 where ``across`` is 0); one across unseen space may be longer in truth by up to ``share`` of that.
     Cells within the circle get 0: their first leg is the test."""
     flat = lengths.ravel()
     inside = flat <= lead
     rim = inside & (flat > lead - 1.5) & along.ravel()
-    if not rim.any():
+    across = share * path_sums(pred, np.where(unseen.ravel(), 1.0, 0.0)).reshape(lengths.shape)
+    if not rim.any() or not (across.ravel()[~inside] > 0).any():
         return np.zeros(lengths.shape)
     held = costs.copy().ravel()
     held[inside & ~rim] = np.inf
     starts = tuple(tuple(int(v) for v in divmod(int(i), lengths.shape[1])) for i in np.flatnonzero(rim))
     with np.errstate(invalid="ignore"):
         detour = searches.lengths_from(kind, held.reshape(lengths.shape), starts) + lead - lengths
-    across = share * path_sums(pred, np.where(unseen.ravel(), 1.0, 0.0)).reshape(lengths.shape)
     with np.errstate(invalid="ignore", divide="ignore"):
         out = np.where((across > 0) & np.isfinite(detour), np.exp(-np.maximum(detour, 0.0) / across), 0.0)
     out.ravel()[inside] = 0.0

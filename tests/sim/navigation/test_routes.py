@@ -14,6 +14,7 @@ from sim.navigation.routes import (
     RouteParams,
     door_depth_weight,
     passed_likelihood,
+    path_sums,
     route_likelihood,
 )
 
@@ -169,3 +170,29 @@ def test_a_sign_not_naming_the_goal_says_nothing_of_a_branch_the_route_leaves_be
     likelihood = passed_likelihood(grid, [(13.0, 3.0)], np.array([2.0, 2.0]))
     assert at(grid, likelihood, 4.0, 8.0) == pytest.approx(1.0 - RouteParams().named_prob)  # round the wall's end
     assert at(grid, likelihood, 8.0, 1.0) == pytest.approx(1.0)
+
+
+def test_path_sums_add_up_each_index_and_its_ancestors():
+    pred = np.array([0, 0, 1, 2, 3, 5])  # a chain 4 -> 3 -> 2 -> 1 -> 0 (the root), and 5 on its own
+    sums = path_sums(pred, np.array([7.0, 1.0, 2.0, 3.0, 4.0, 9.0]))
+    assert sums.tolist() == [0.0, 1.0, 3.0, 6.0, 10.0, 0.0]  # roots count 0
+
+
+def test_an_arrow_against_a_route_across_unseen_space_does_not_rule_its_place_out():
+    """A corridor (y 0 .. 2) whose north wall has one gap, at x 2 .. 4, west of the reader. The robot has mapped
+    the corridor and its wall up to x 10; beyond, and north of the wall, nothing. Over that map the shortest route
+    to a place far to the north-east sets off east and crosses the unseen wall, against the arrow west (which is
+    right: the true route takes the gap). A route that sets off west is only a little longer across the same
+    unseen space, so the place stays likely; by the first leg alone it would not."""
+    size = (20.0, 30.0)
+    west = Arrow(sign_xy=(8.0, 0.0), facing=math.pi / 2, direction=math.pi, wrong_prob=0.1)
+    grid = grid_of([(0.0, 2.0, 2.0, 2.2), (4.0, 20.0, 2.0, 2.2)], size)
+    xy = grid.cell_to_world(np.argwhere(np.ones(grid.shape, dtype=bool)))
+    cells = grid.world_to_cell(xy)
+    unseen = (xy[:, 1] >= 2.2) | ((xy[:, 1] >= 2.0) & (xy[:, 0] >= 10.0))
+    grid.log_odds[cells[unseen, 0], cells[unseen, 1]] = 0.0
+    place = (14.0, 25.0)
+    assert at(grid, route_likelihood(grid, [west], RouteParams(unseen_detour=0.0)), *place) < 0.15
+    assert at(grid, route_likelihood(grid, [west]), *place) > 0.4
+    along_the_mapped_corridor = (16.0, 1.0)  # east of the reader over mapped floor: the arrow still rules it out
+    assert at(grid, route_likelihood(grid, [west]), *along_the_mapped_corridor) < 0.15
