@@ -18,7 +18,12 @@ with ``wrong`` the chance the arrow is wrong (misleading signs) or, for an
 arrow naming an area that holds the place, that the area's route is not the
 place's. Early on, with nothing mapped, ``L`` is a cone about the arrow; as
 walls are mapped it follows corridors round corners, and an arrow pointing
-away from a place behind a wall says the way round lies that way.
+away from a place behind a wall says the way round lies that way. A route
+planned across unseen space may be wrong about its first leg (walls not yet
+seen can turn it), so a cell whose first leg misses the arrow keeps
+``exp(-detour / (unseen_detour * unseen))`` instead when that is more: how much
+longer a route is that sets off along the arrow, against how much of its own
+route near the reader crosses unseen space (``_unseen_way``).
 
 Labels hang beside doors on the side a door is approached from, so a room's
 inner walls carry only the labels of rooms reached through it. From the start
