@@ -202,21 +202,20 @@ def _unseen_way(lengths: np.ndarray, pred: np.ndarray, along: np.ndarray, costs:
     cells) the shortest route is that leaves the reader's circle of ``lead`` cells where the arrow points
     (``along``: each cell's first leg lies within the tolerance; the route may not come back through the circle)
     and ``across`` the cells of the shortest route that lie in ``unseen`` space (those near enough the reader to
-    turn its first leg). A route over mapped space is what
-    it is (0 where ``across`` is 0); one across unseen space may be longer in truth by up to ``share`` of that.
-    Cells within the circle get 0: their first leg is the test."""
+    turn its first leg). A route over mapped space is what it is (0 where ``across`` is 0); one across unseen
+    space may be longer in truth by up to ``share`` of that. Cells within the circle get 0: their first leg is
+    the test."""
     flat = lengths.ravel()
     inside = flat <= lead
-    rim = inside & (flat > lead - 1.5) & along.ravel()
+    rim = inside & (flat > lead - 1.5) & along.ravel()  # within one diagonal step (1.41 cells) of the circle's edge
     across = share * path_sums(pred, np.where(unseen.ravel(), 1.0, 0.0)).reshape(lengths.shape)
     if not rim.any() or not (across.ravel()[~inside] > 0).any():
         return np.zeros(lengths.shape)
     held = costs.copy().ravel()
     held[inside & ~rim] = np.inf
     starts = tuple(tuple(int(v) for v in divmod(int(i), lengths.shape[1])) for i in np.flatnonzero(rim))
-    with np.errstate(invalid="ignore"):
-        detour = searches.lengths_from(kind, held.reshape(lengths.shape), starts) + lead - lengths
     with np.errstate(invalid="ignore", divide="ignore"):
+        detour = searches.lengths_from(kind, held.reshape(lengths.shape), starts) + lead - lengths
         out = np.where((across > 0) & np.isfinite(detour), np.exp(-np.maximum(detour, 0.0) / across), 0.0)
     out.ravel()[inside] = 0.0
     return out
