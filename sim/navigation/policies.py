@@ -494,6 +494,7 @@ class GuidedPolicy(AbstractMapPolicy):
                                    cone_half_angle_deg=sp.sweep_cone_deg)
         self.seen_at = -float("inf")
         self.zones_version = -1
+        self.stop: Spot | None = None  # the unread plate the robot is stepping in front of before its door
 
     def forget_target(self) -> None:
         self.search.target = None
@@ -527,12 +528,29 @@ class GuidedPolicy(AbstractMapPolicy):
             self.zones_version = self.tags.version
         v, w = self.search.command(t_s, pose, grid, tick_s, rng, value=lambda covered: self._values(
             grid, covered, robot_xy), offset_m=self.params.guide.offset_m, floor=self.params.guide.floor)
+        self._read_before_door()
         if self.search.arrived_at is not None:
             self.tags.give_up_at(grid, self.search.arrived_at)
             self.search.arrived_at = None
         if self.search.exhausted:
             self.gave_up = NO_FRONTIER
         return v, w
+
+    def _read_before_door(self) -> None:
+        """When the planned path enters a door beside a plate not yet read, stand in front of the plate first
+        (:meth:`~sim.navigation.spotted.SpottedTags.door_stop`); once it is read (or given up) the search
+        chooses afresh. The next tick drives to the new target."""
+        if self.stop is not None and self.stop not in self.tags.unread:
+            self.stop = None
+            self.search.target = None
+        plan = self.drive.plan
+        if self.search.target is None or plan is None:
+            return
+        found = self.tags.door_stop(plan.waypoints)
+        if found is None or float(np.hypot(*(found[1] - self.search.target))) < 1e-6:
+            return
+        self.stop, self.search.target = found
+        self.drive.replanner.request()
 
     def picture(self) -> tuple[dict[str, tuple[float, float]], tuple[float, float], np.ndarray | None]:
         plan = self.drive.plan

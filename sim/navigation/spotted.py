@@ -13,7 +13,12 @@ read, and gives the guided search three grids (the occupancy grid's cells):
 - ``zones``: for each unread plate, the free space in front of it from which it
   is read (square to it, 1.2-3 m out): the search treats that space as not yet
   looked at, so a frontier forms there and carries the plate's belief, and the
-  robot drives to stand in front of it.
+  robot drives to stand in front of it;
+- ``door_stop``: where to read the first unread plate beside a doorway that a
+  planned path is about to pass through into the space behind the plate. A
+  door's plate hangs beside it facing the way the door is approached and names
+  the room behind, so a person reads it before going in; a robot that turns
+  in first has the plate edge-on and then behind it.
 
 World frame, metres.
 """
@@ -46,6 +51,10 @@ class SpottedParams:
     # the spotter's 8 m less a margin
     sweep_cone_deg: float = 70.0  # deg about the wall's normal: the spotter's 75 less a margin
     sweep_every_s: float = 0.4  # s of simulated time between such sweeps: the perception's 2.5 Hz
+    door_reach_m: float = 1.5  # m along its wall from a plate where a path crossing the wall passes the plate's
+    # door: a door's width (about 1 m) plus the plate's offset from its jamb
+    read_at_m: float = 2.0  # m out along a plate's normal where the robot stops to read it before its door:
+    # the middle of the reading zone
 
 
 class SpottedTags:
@@ -123,6 +132,33 @@ class SpottedTags:
             on_plate = float(mass[rows, cols][d <= self.params.tag_radius_m].sum())
             out[rows, cols] = np.maximum(out[rows, cols], np.where(zone, on_plate, 0.0))
         return out
+
+    def door_stop(self, waypoints: np.ndarray) -> tuple[Spot, np.ndarray] | None:
+        """The first unread plate whose door the path ``waypoints`` ((N, 2) m, from the robot) passes through
+        from the plate's face to behind it, within ``door_reach_m`` of the plate along its wall, and the point
+        ``read_at_m`` in front of it where it is read; None when the path passes no such door."""
+        prm = self.params
+        pts = np.asarray(waypoints, dtype=float)
+        if not self.unread or len(pts) < 2:
+            return None
+        a, b = pts[:-1], pts[1:]
+        first: tuple[int, Spot] | None = None
+        for u in self.unread:
+            normal = np.array([math.cos(u.theta), math.sin(u.theta)])
+            ahead = (pts - [u.x, u.y]) @ normal  # m in front of the plate's wall
+            cross = np.flatnonzero((ahead[:-1] > 0.0) & (ahead[1:] <= 0.0))
+            if cross.size == 0:
+                continue
+            share = ahead[cross] / (ahead[cross] - ahead[cross + 1])
+            at = a[cross] + share[:, None] * (b[cross] - a[cross])
+            along = np.abs((at - [u.x, u.y]) @ np.array([-normal[1], normal[0]]))
+            hits = cross[along <= prm.door_reach_m]
+            if hits.size and (first is None or hits[0] < first[0]):
+                first = (int(hits[0]), u)
+        if first is None:
+            return None
+        u = first[1]
+        return u, np.array([u.x + prm.read_at_m * math.cos(u.theta), u.y + prm.read_at_m * math.sin(u.theta)])
 
     def give_up_at(self, grid: OccupancyGrid, xy: np.ndarray) -> bool:
         """The robot stood at ``xy`` (m) and read no plate whose zone holds it: those plates cannot be read from
