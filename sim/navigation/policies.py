@@ -476,7 +476,8 @@ class GuidedPolicy(AbstractMapPolicy):
     carries all it leads to and a room's doorway only the room. Walls seen from
     afar with no plate on them are ruled out, and the space in front of each
     plate seen but not yet read counts as unlooked, so the robot steps in front
-    of it (:mod:`sim.navigation.spotted`). The search is complete: it ends when
+    of it (:mod:`sim.navigation.spotted`), and it reads a door's plate before
+    going through the door. The search is complete: it ends when
     the goal's label is read or no frontier is left.
     """
 

@@ -69,3 +69,21 @@ def test_parameters_keep_the_zone_inside_the_reading_rule():
     p = SpottedParams()
     assert p.zone_far_m < 4.0 and p.zone_half_angle_deg < 45.0 and p.zone_near_m >= 1.0
     assert p.sweep_range_m < 8.0 and p.sweep_cone_deg < 75.0
+
+
+def test_a_path_through_the_door_beside_an_unread_plate_stops_in_front_of_it_first():
+    tags = SpottedTags()
+    tags.update([], [PLATE])
+    into_door = np.array([[6.0, 1.0], [9.0, 3.5], [9.0, 6.0]])  # diagonally up to the door at x = 9, then through
+    found = tags.door_stop(into_door)
+    assert found is not None
+    plate, stop = found
+    assert plate == PLATE
+    assert stop == pytest.approx([10.0, 4.0 - SpottedParams().read_at_m])  # square in front, inside its zone
+    assert tags.door_stop(into_door[::-1]) is None  # leaving through the door faces the plate: read on the way
+    along = np.array([[2.0, 2.0], [18.0, 2.0]])
+    assert tags.door_stop(along) is None  # walking the corridor passes it (its zone does the rest)
+    far_door = np.array([[6.0, 1.0], [14.0, 3.5], [14.0, 6.0]])
+    assert tags.door_stop(far_door) is None  # a door 4 m along the wall is another room's
+    tags.update([Sighting(7, 10.0, 4.0, -math.pi / 2, 2.0)], [])
+    assert tags.door_stop(into_door) is None  # read: nothing to stop for
