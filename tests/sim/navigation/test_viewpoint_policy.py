@@ -108,6 +108,36 @@ def test_guided_stands_in_front_of_a_plate_seen_until_it_is_read(tiny_world):
     assert policy.search.unlooked is not None and not policy.search.unlooked.any()
 
 
+def test_guided_reads_a_doors_plate_before_going_through_the_door(tiny_world):
+    """A planned path through the gap beside an unread plate turns first to the point in front of the plate;
+    once the plate is read the search chooses afresh."""
+    import numpy as np
+
+    from sim.experiments.trial import TrialParams, occupancy_grid, policy_params
+    from sim.navigation.planner import Plan
+    from sim.navigation.policies import GuidedPolicy
+    from sim.perception.sighting import Sighting
+    from sim.perception.spotting import Spot
+
+    goal = sorted(tiny_world.goals)[0]
+    params = policy_params(TrialParams())
+    policy = GuidedPolicy(tiny_world, goal, tiny_world.start, params)
+    grid = occupancy_grid(tiny_world, TrialParams())
+    plate = Spot(6.0, 4.0, np.pi, 4.0)  # on the inner wall's west face, 1 m below its end at y = 5
+    policy.observe([], t_s=0.0, distance_m=0.0, grid=grid, spotted=[plate])
+    around = np.array([[2.0, 2.0], [5.5, 5.5], [7.0, 5.5]])  # round the wall's end: crosses its line 1.5 m
+    # from the plate, from its face to behind it
+    policy.drive.replanner.plan = Plan(around, 6.5, True, (7.0, 5.5))
+    policy.search.target = np.array([7.0, 5.5])
+    policy._read_before_door()
+    read_at = params.spotted.read_at_m
+    assert policy.search.target == pytest.approx([6.0 - read_at, 4.0])
+    assert policy.stop == plate
+    policy.observe([Sighting(3, plate.x, plate.y, plate.theta, 2.0)], t_s=1.0, distance_m=3.0, grid=grid)
+    policy._read_before_door()
+    assert policy.search.target is None and policy.stop is None
+
+
 @pytest.mark.parametrize("navigator, spots", [("guided", True), ("paper", False), ("frontier", False)])
 def test_plates_are_spotted_only_for_a_navigator_that_takes_them_in(tiny_world, navigator, spots):
     from sim.experiments.trial import Trial
