@@ -496,6 +496,7 @@ class GuidedPolicy(AbstractMapPolicy):
         self.seen_at = -float("inf")
         self.zones_version = -1
         self.stop: Spot | None = None  # the unread plate the robot is stepping in front of before its door
+        self.door_asked: tuple | None = None  # (plan, plates' version, target) of the latest door_stop check
 
     def forget_target(self) -> None:
         self.search.target = None
@@ -547,6 +548,10 @@ class GuidedPolicy(AbstractMapPolicy):
         plan = self.drive.plan
         if self.search.target is None or plan is None:
             return
+        asked = (plan, self.tags.version, tuple(self.search.target))
+        if self.door_asked is not None and asked[0] is self.door_asked[0] and asked[1:] == self.door_asked[1:]:
+            return  # the same path, plates and target as at the latest check: the same answer (no stop)
+        self.door_asked = asked
         found = self.tags.door_stop(plan.waypoints)
         if found is None or float(np.hypot(*(found[1] - self.search.target))) < 1e-6:
             return
