@@ -216,6 +216,9 @@ class RecoveryParams:
     backoff_speed: float = -0.2  # m/s (negative: backwards)
     rotate_rad: float = math.pi / 2  # rad to turn after backing off
     rotate_rate: float = 0.4  # rad/s magnitude of the turn
+    max_in_place: int = 10  # recoveries in a row that leave the robot within ``escape_m`` of where the first one
+    # began: it is wedged (a body pinned on a wall's end turns no wheel); each takes ~10 s, so ~100 s of trying
+    escape_m: float = 0.5  # m the robot must get from where a run of recoveries began for the run to end
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.backoff_s) and self.backoff_s >= 0):
@@ -226,6 +229,10 @@ class RecoveryParams:
             raise ValueError(f"RecoveryParams.rotate_rad must be finite and >= 0, got {self.rotate_rad}")
         if not (math.isfinite(self.rotate_rate) and self.rotate_rate > 0):
             raise ValueError(f"RecoveryParams.rotate_rate must be finite and > 0, got {self.rotate_rate}")
+        if self.max_in_place < 1:
+            raise ValueError(f"RecoveryParams.max_in_place must be >= 1, got {self.max_in_place}")
+        if not (math.isfinite(self.escape_m) and self.escape_m > 0):
+            raise ValueError(f"RecoveryParams.escape_m must be finite and > 0, got {self.escape_m}")
 
 
 def recovery_commands(params: RecoveryParams = RecoveryParams(),

@@ -100,12 +100,18 @@ class Policy(Protocol):
 
 
 class DriveStack:
-    """Re-planning, path following and stuck recovery towards a target: the part every policy shares."""
+    """Re-planning, path following and stuck recovery towards a target: the part every policy shares.
+
+    :attr:`wedged` says why driving is hopeless (empty while it is not): ``RecoveryParams.max_in_place``
+    recoveries in a row left the robot where the first began."""
 
     def __init__(self, params: PolicyParams) -> None:
         self.replanner = Replanner(params.replan, params.planner)
         self.follower = PathFollower(params.follower)
         self.stuck, self.recovery = StuckDetector(StuckParams()), Recovery(RecoveryParams())
+        self.in_place = 0  # recoveries in a row within ``escape_m`` of where the run began
+        self.run_from: np.ndarray | None = None  # m, where the robot stood when the run's first recovery began
+        self.wedged = ""
 
     @property
     def plan(self) -> Plan | None:
@@ -127,11 +133,39 @@ class DriveStack:
         v, w, done = self.follower.command(pose, plan.waypoints, tick_s)
         arrived = done and float(np.hypot(*(np.array(plan.goal_xy) - pose[:2]))) < arrive_m
         if self.stuck.update(t_s, pose, commanded=abs(v) > 0.01 or abs(w) > 0.01):
+            self._count_recovery(np.asarray(pose[:2], dtype=float))
             self.recovery.start(t_s, turn_sign=1.0 if rng.random() < 0.5 else -1.0)
         return v, w, arrived
 
+    def _count_recovery(self, xy: np.ndarray) -> None:
+        """One more recovery starting at ``xy`` (m): it extends the run when the robot is still near where the
+        run began; after ``max_in_place`` of them the robot is :attr:`wedged`."""
+        prm = self.recovery.params
+        if self.run_from is None or float(np.hypot(*(xy - self.run_from))) >= prm.escape_m:
+            self.run_from, self.in_place = xy, 0
+        self.in_place += 1
+        if self.in_place >= prm.max_in_place and not self.wedged:
+            self.wedged = (f"wedged at ({xy[0]:.1f}, {xy[1]:.1f}) m: {self.in_place} stuck recoveries in a row "
+                           f"left the robot within {prm.escape_m:g} m of where the first began")
 
-class AbstractMapPolicy:
+
+class Driven:
+    """A policy that drives with a :class:`DriveStack`: it stops when it gives up, or when the robot is wedged."""
+
+    drive: DriveStack
+    stopped = ""  # why the policy itself stopped (empty: it has not)
+
+    @property
+    def gave_up(self) -> str:
+        """Why the policy stopped (non-empty ends the trial): its own reason, or :attr:`DriveStack.wedged`."""
+        return self.stopped or self.drive.wedged
+
+    @gave_up.setter
+    def gave_up(self, why: str) -> None:
+        self.stopped = why
+
+
+class AbstractMapPolicy(Driven):
     """What every policy that keeps an abstract map shares: the model, its drive stack, cues and settle times."""
 
     target: object | None  # the current target, forgotten when the model changes
@@ -344,7 +378,7 @@ class FrontierSearch:
         return (math.nan, math.nan) if self.target is None else (float(self.target[0]), float(self.target[1]))
 
 
-class FrontierPolicy:
+class FrontierPolicy(Driven):
     """Explore without reading signs: the nearest reachable frontier, until the goal's label is read.
 
     The trial judges success from the goal's label, so this policy ignores every

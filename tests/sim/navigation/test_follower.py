@@ -137,3 +137,44 @@ def test_recovery_backs_off_rotates_then_asks_for_a_replan() -> None:
     replans = [k for k, s in enumerate(steps) if s.replan]
     assert len(replans) == 1 and phases[replans[0]] == "idle"
     assert not recovery.active
+
+
+def pinned_drive(poses, ticks: int, tick_s: float = 0.2):
+    """A DriveStack told to drive to a target 6 m away on an open 10 m x 10 m map while the robot stands at
+    ``poses(k)`` at tick ``k``; returns the drive stack and the first tick it said it was wedged (None: never)."""
+    from sim.experiments.trial import TrialParams, policy_params
+    from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
+    from sim.navigation.policies import DriveStack
+
+    grid = OccupancyGrid(OccupancyParams(resolution_m=0.1, bounds=(0.0, 10.0, 0.0, 10.0)))
+    grid.log_odds[:] = -2.0  # all mapped free
+    drive, rng = DriveStack(policy_params(TrialParams())), np.random.default_rng(0)
+    for k in range(ticks):
+        drive.drive(k * tick_s, poses(k), grid, np.array([8.0, 8.0]), tick_s, 0.5, rng)
+        if drive.wedged:
+            return drive, k
+    return drive, None
+
+
+def test_a_robot_that_recoveries_cannot_move_is_wedged_and_says_where() -> None:
+    drive, at = pinned_drive(lambda k: (2.0, 2.0, 0.0), ticks=2000)
+    params = RecoveryParams()
+    assert at is not None and drive.in_place == params.max_in_place
+    assert at * 0.2 > 5.0 * params.max_in_place  # ~10 s a recovery: a wedge is called only after long trying
+    assert drive.wedged.startswith("wedged at (2.0, 2.0) m: 10 stuck recoveries in a row")
+
+
+def test_recoveries_that_free_the_robot_do_not_add_up_to_a_wedge() -> None:
+    # each run of ~20 s pinned ends with the robot 1 m on: stuck again and again, but never in one place
+    drive, at = pinned_drive(lambda k: (1.0 + (k // 100) * 1.0, 2.0, 0.0), ticks=900)
+    assert at is None and not drive.wedged and 1 <= drive.in_place < RecoveryParams().max_in_place
+
+
+def test_a_wedged_robot_ends_the_policy() -> None:
+    from sim.navigation.policies import FrontierPolicy
+
+    policy = FrontierPolicy.__new__(FrontierPolicy)
+    policy.drive = pinned_drive(lambda k: (2.0, 2.0, 0.0), ticks=2000)[0]
+    assert policy.gave_up.startswith("wedged at")
+    policy.gave_up = "no frontier left"  # the policy's own reason comes first
+    assert policy.gave_up == "no frontier left"
