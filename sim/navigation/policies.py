@@ -177,7 +177,6 @@ class AbstractMapPolicy(Driven):
         self.target = None
         self.target_at = -float("inf")
         self.bumps = 0  # exploration bumps in all
-        self.gave_up = ""
         self.start = np.asarray(start, dtype=float)
         self.depth = np.ones(1)  # door-depth weight per grid cell (sim.navigation.routes), set with the belief
         self.evidence: np.ndarray | None = None  # depth x route likelihood, per grid cell
@@ -393,7 +392,6 @@ class FrontierPolicy(Driven):
         self.drive = DriveStack(params)
         self.search = FrontierSearch(params, self.drive, frontier or FrontierParams())
         self.cues: list[CueEvent] = []  # reads no sign
-        self.gave_up = ""
 
     def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
                 grid: OccupancyGrid, spotted: Sequence[Spot] = ()) -> None:

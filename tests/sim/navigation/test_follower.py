@@ -140,7 +140,7 @@ def test_recovery_backs_off_rotates_then_asks_for_a_replan() -> None:
 
 
 def pinned_drive(poses, ticks: int, tick_s: float = 0.2):
-    """A DriveStack told to drive to a target 6 m away on an open 10 m x 10 m map while the robot stands at
+    """A DriveStack told to drive to (8, 8) m on an open 10 m x 10 m map while the robot stands at
     ``poses(k)`` at tick ``k``; returns the drive stack and the first tick it said it was wedged (None: never)."""
     from sim.experiments.trial import TrialParams, policy_params
     from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
