@@ -205,6 +205,17 @@ def generalise_tables(records: list[dict], title: str) -> None:
                          f"{wall / len(mine):.1f}", f"{cpu / len(mine):.1f}", f"{wall / 60:.1f}"])
         table(f"{title}, per navigator and {column}", [h.format(column) for h in header], rows)
     explained_failures(records, title)
+    walk_phases(records, title)
+
+
+def walk_phases(records: list[dict], title: str) -> None:
+    """Where the walking went (``sim.experiments.walk``) per perception, navigator and signage level."""
+    from sim.experiments.summary import WALK_HEADER, walk_rows
+
+    rows = walk_rows(records, lambda r: (r["perception"], r["navigator"], r.get("signage") or "-"))
+    if rows:
+        table(f"{title}, where the walking went (mean m per trial)", ["perception", "navigator", "signage",
+                                                                      *WALK_HEADER], rows)
 
 
 def explained_failures(records: list[dict], title: str) -> None:

@@ -35,7 +35,7 @@ from sim.experiments.trial import TrialParams
 from sim.world.data import World
 
 CSV_FIELDS = ["world", "style", "signage", "navigator", "goal", "seed", "perception", "success", "reason",
-              "explanation", "distance_m", "oracle_m", "spl", "sim_s", "wall_s", "cpu_s"]
+              "explanation", "distance_m", "oracle_m", "spl", "near_at_m", "seen_at_m", "sim_s", "wall_s", "cpu_s"]
 SETTINGS_FILE = "settings.json"
 SETTINGS_FORMAT = "abstract-map-study/2"
 

@@ -20,6 +20,7 @@ import numpy as np
 
 from sim.experiments.diagnosis import KINDS
 from sim.experiments.pictures import draw_floorplan, draw_path, draw_tags
+from sim.experiments.walk import PHASES, phase_means
 from sim.world.data import World
 
 Record = dict[str, Any]
@@ -76,6 +77,28 @@ def grouped_table(records: list[Record], columns: list[str], key: Callable[[Reco
              "|" + " --- |" * (len(columns) + 5)]
     lines += [_row(list(k), stats(v)) for k, v in sorted(groups.items())]
     return lines
+
+
+WALK_HEADER = ["result", "trials", "walked", "oracle", *PHASES]  # after the group's own columns
+
+
+def walk_rows(records: list[Record], key: Callable[[Record], tuple[str, ...]]) -> list[list[str]]:
+    """Where the walking went (:mod:`sim.experiments.walk`) per group ``key(record)``, found and failed trials
+    apart: the group, "found" or "failed", trials, then mean metres per trial walked, of the oracle's and of
+    each phase. Groups whose records carry no walk marks are left out."""
+    groups: dict[tuple[str, ...], list[Record]] = {}
+    for record in records:
+        groups.setdefault((*key(record), "found" if record["success"] else "failed"), []).append(record)
+    rows = []
+    for group, mine in sorted(groups.items()):
+        means = phase_means(mine)
+        if means is None:
+            continue
+        n, split = means
+        oracle = [r["oracle_m"] for r in mine if r.get("oracle_m") is not None]
+        rows.append([*group, str(n), _f(sum(split), ".1f"), _f(float(np.mean(oracle)) if oracle else math.nan, ".1f"),
+                     *[_f(v, ".1f") for v in split]])
+    return rows
 
 
 def worst_trials(records: list[Record], n: int = 10) -> list[Record]:
@@ -163,6 +186,15 @@ def summary_markdown(records: list[Record], *, worst: list[Record], pictures: It
         lines += [f"| {n} | {reason} | {kind} | {count} |" for (n, reason, kind), count in sorted(failures.items())]
     else:
         lines.append("None: every trial found its goal.")
+    walks = walk_rows(records, lambda r: (nav(r), r.get("signage") or "-"))
+    if walks:
+        lines += ["", "### Where the walking went", "",
+                  "Mean metres per trial, split where the robot first came within 8 m (by the floor plan) of a pose "
+                  "that reads the goal's label (*far* before it) and where it first saw the label, unread, by the "
+                  "spotting rule (`sim/experiments/walk.py`). Metres in the later phases beyond the oracle's last "
+                  "few are a search that came close and turned away.", "",
+                  "| " + " | ".join(["navigator", "signage", *WALK_HEADER]) + " |", "|" + " --- |" * 9,
+                  *["| " + " | ".join(row) + " |" for row in walks]]
     lines += ["", "### Per world", ""]
     lines += grouped_table(records, ["world", "style", "signage", "navigator"],
                            lambda r: (r.get("world", ""), r.get("style") or "-", r.get("signage") or "-", nav(r)))

@@ -21,6 +21,7 @@ import numpy as np
 
 from abstract_map.grammar import Anchor
 from sim.experiments.diagnosis import Explanation, ReadingRules, explain, names_place
+from sim.experiments.walk import walk_marks
 from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
 from sim.navigation.belief import BeliefParams
 from sim.navigation.follower import FollowerParams
@@ -129,6 +130,8 @@ class TrialResult:
     cpu_s: float = math.nan  # s of this process's CPU time: unlike wall time, not stretched by a busy machine
     unsettled: int = 0  # settles of the abstract map stopped by its step cap (DynamicsParams.max_iterations)
     explanation: str = ""  # a failure's "kind: particulars" (sim.experiments.diagnosis); "" for a success
+    near_at_m: float | None = None  # m walked when first near the goal's label (sim.experiments.walk); None: never
+    seen_at_m: float | None = None  # m walked when the goal's label was first seen, unread; None: never
 
     @property
     def realtime_factor(self) -> float:
@@ -145,6 +148,7 @@ class TrialResult:
             "cues": [asdict(c) for c in self.cues],
             "exploration_bumps": self.exploration_bumps, "settle_median_ms": round(self.settle_median_ms, 2),
             "unsettled": self.unsettled, "explanation": self.explanation,
+            "near_at_m": _rounded(self.near_at_m), "seen_at_m": _rounded(self.seen_at_m),
             "final_positions": {k: [round(v[0], 3), round(v[1], 3)] for k, v in self.final_positions.items()},
             "trajectory": [[round(float(v), 3) for v in row] for row in self.trajectory],
         }
@@ -152,6 +156,11 @@ class TrialResult:
 
 Progress = Callable[[float, float, int], None]
 """Called about once per simulated second with (sim time s, distance m, cues read)."""
+
+
+def _rounded(value: float | None, digits: int = 2) -> float | None:
+    """``value`` rounded for a record, None kept."""
+    return None if value is None else round(value, digits)
 
 
 def _start_pose(world: World, params: TrialParams, rng: np.random.Generator) -> tuple[float, float, float]:
@@ -341,6 +350,7 @@ class Trial:
             self.progress(self.t, self.distance, len(self.policy.cues))
         settles = self.policy.settles()
         settle_ms = [s.wall_s * 1000 for s in settles[1:] or settles]  # the first settle places the whole hierarchy
+        marks = walk_marks(self.world, self.goal, np.array(trajectory), self.distance, spot=self.params.spotting)
         return TrialResult(
             world=self.world.name, goal=self.goal, seed=self.seed, perception=self.mode, success=self.success,
             reason=self.reason, distance_m=self.distance, sim_s=self.t, wall_s=time.perf_counter() - self.began,
@@ -350,6 +360,7 @@ class Trial:
             grid_extent=self.grid.extent, navigator=self.navigator, cpu_s=time.process_time() - self.began_cpu,
             unsettled=sum(not s.settled for s in settles),
             explanation="" if self.success else str(self.explain(self.goal, np.array(trajectory))),
+            near_at_m=marks.near_at_m, seen_at_m=marks.seen_at_m,
         )
 
 
@@ -361,11 +372,15 @@ class Trial:
         for goal in self.watched:
             reading = self.readings.get(goal)
             if reading is None:
+                marks = walk_marks(self.world, goal, result.trajectory, result.distance_m, spot=self.params.spotting)
                 out[goal] = replace(result, goal=goal, success=False,
-                                    explanation=str(self.explain(goal, result.trajectory)))
+                                    explanation=str(self.explain(goal, result.trajectory)),
+                                    near_at_m=marks.near_at_m, seen_at_m=marks.seen_at_m)
                 continue
             trajectory = np.array([*self.trajectory[:reading.trajectory_len], (reading.t_s, *reading.pose)])
+            marks = walk_marks(self.world, goal, trajectory, reading.distance_m, spot=self.params.spotting)
             out[goal] = replace(result, goal=goal, success=True, reason="goal label read",
+                                near_at_m=marks.near_at_m, seen_at_m=marks.seen_at_m,
                                 distance_m=reading.distance_m, sim_s=reading.t_s, wall_s=reading.wall_s,
                                 cpu_s=reading.cpu_s, trajectory=trajectory,
                                 frames=[f for f in result.frames if f.t_s <= reading.t_s], explanation="")

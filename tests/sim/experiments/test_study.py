@@ -172,7 +172,7 @@ def test_multi_world_study_resumes_across_worlds_and_refuses_other_settings(tiny
     assert all(r["oracle_m"] > 0 and r["spl"] is not None for r in first.records)
     rows = list(csv.DictReader((out / "trials.csv").open()))
     assert {"world", "navigator", "oracle_m", "spl", "goal", "seed", "distance_m", "reason",
-            "explanation"} <= set(rows[0])
+            "explanation", "near_at_m", "seen_at_m"} <= set(rows[0])
     # resume: a trial file removed is the only one run again
     files = sorted((out / "trials").rglob("*.json"))
     assert len(files) == 4
@@ -181,7 +181,8 @@ def test_multi_world_study_resumes_across_worlds_and_refuses_other_settings(tiny
     conduct_study(settings, out, workers=1, progress=lambda done, total, record: calls.append((done, total)))
     assert calls == [(3, 4), (4, 4)]
     report = (out / "report.md").read_text()
-    for section in ("## Over all trials", "### Failures by reason", "### Per world", "worst trials"):
+    for section in ("## Over all trials", "### Failures by reason", "### Where the walking went", "### Per world",
+                    "worst trials"):
         assert section in report
     with pytest.raises(StudyError, match="trials"):
         conduct_study(settings_for(tiny_world, worlds=settings.worlds, navigators=settings.navigators, trials=2),

@@ -15,6 +15,8 @@ def test_tiny_trial_finds_the_label(tiny_world, perception):
     result = run_trial(tiny_world, "A", seed=1, perception=perception)
     assert result.success, result.reason
     assert result.reason == "goal label read" and result.explanation == ""
+    assert result.near_at_m == 0.0  # the start is within 8 m of a pose that reads the label, and sees it
+    assert result.seen_at_m == 0.0 and result.to_dict()["seen_at_m"] == 0.0
     assert [c.tag_id for c in result.cues][-1] == 0
     assert 0.0 <= result.distance_m < 3.0
     steps = np.hypot(*np.diff(result.trajectory[:, 1:3], axis=0).T)
@@ -88,6 +90,7 @@ def test_one_goal_blind_run_stands_for_one_trial_per_goal(tmp_path):
         assert (mine.success, mine.distance_m, mine.sim_s) == (alone.success, alone.distance_m, alone.sim_s)
         assert mine.reason == alone.reason
         assert mine.explanation == alone.explanation
+        assert (mine.near_at_m, mine.seen_at_m) == (alone.near_at_m, alone.seen_at_m)
         assert np.allclose(mine.trajectory[-1], alone.trajectory[-1])
 
 
