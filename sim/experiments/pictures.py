@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from abstract_map.files import atomic_path
+from sim.experiments.walk import point_at
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -56,6 +57,22 @@ def draw_path(ax: Axes, trajectory: np.ndarray, *, colour: Any = "tab:blue", lab
     ax.plot(trajectory[-1, 1], trajectory[-1, 2], "x", color=colour, ms=10, mew=2, zorder=5)
 
 
+WALK_MARKS = (("near_at_m", "^", "first near the label"), ("seen_at_m", "D", "label first seen"))
+"""Each walk mark (:mod:`sim.experiments.walk`): its field, its marker and its legend text."""
+
+
+def draw_walk_marks(ax: Axes, trajectory: np.ndarray, distance_m: float, marks: dict[str, float | None], *,
+                    colour: Any = "tab:blue") -> None:
+    """Where along ``trajectory`` (N, >=3: t, x, y, ...; ``distance_m`` long) the robot first came near the
+    goal's label and first saw it (``marks``: the fields of :data:`WALK_MARKS`, m walked; None: never)."""
+    for field, marker, text in WALK_MARKS:
+        at = marks.get(field)
+        if at is None or len(trajectory) == 0:
+            continue
+        x, y = point_at(trajectory, distance_m, at)
+        ax.plot(x, y, marker, mfc="white", mec=colour, ms=9, mew=2, zorder=6, label=f"{text}, {at:.1f} m")
+
+
 def draw_places(ax: Axes, places: dict[str, tuple[float, float]], goal: str | None = None,
                 *, names: bool = True) -> None:
     """Imagined places as dots (the goal as a star)."""
@@ -95,6 +112,8 @@ def _trajectory_figure(plt: Any, result: TrialResult, world: World) -> Any:
     draw_tags(ax, world, read=[c.tag_id for c in result.cues], goal_tags=goal_tags)
     draw_places(ax, result.final_positions, result.goal)
     draw_path(ax, result.trajectory, label=f"robot, {result.distance_m:.1f} m")
+    draw_walk_marks(ax, result.trajectory, result.distance_m,
+                    {"near_at_m": result.near_at_m, "seen_at_m": result.seen_at_m})
     x0, x1, y0, y1 = world.floorplan.extent
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)

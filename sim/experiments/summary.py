@@ -18,8 +18,9 @@ from typing import Any
 
 import numpy as np
 
+from abstract_map.files import atomic_path
 from sim.experiments.diagnosis import KINDS
-from sim.experiments.pictures import draw_floorplan, draw_path, draw_tags
+from sim.experiments.pictures import draw_floorplan, draw_path, draw_tags, draw_walk_marks
 from sim.experiments.walk import PHASES, phase_means
 from sim.world.data import World
 
@@ -122,8 +123,11 @@ def trial_picture(record: Record, world: World, path: Path, oracle: np.ndarray |
     draw_tags(ax, world, goal_tags=[t.id for t in world.label_tags(record["goal"])])
     if record.get("trajectory"):
         verdict = f"{record['distance_m']:.1f} m" if record["success"] else "failed"
-        draw_path(ax, np.array(record["trajectory"]), colour="tab:green" if record["success"] else "tab:red",
+        colour = "tab:green" if record["success"] else "tab:red"
+        trajectory = np.array(record["trajectory"])
+        draw_path(ax, trajectory, colour=colour,
                   label=f"{record.get('navigator', '')} seed {record['seed']}: {verdict}")
+        draw_walk_marks(ax, trajectory, record["distance_m"], record, colour=colour)
     if oracle is not None:
         ax.plot(oracle[:, 0], oracle[:, 1], color="black", ls="--", lw=1.5, label="oracle")
     x0, x1, y0, y1 = world.floorplan.extent
@@ -134,8 +138,8 @@ def trial_picture(record: Record, world: World, path: Path, oracle: np.ndarray |
     ax.set_title(f"{world.name}: {record['goal']} (SPL {_f(spl)}; {record.get('reason', '')}){why}", fontsize=9)
     ax.legend(loc="lower right", fontsize=7)
     fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=90)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=90)
     plt.close(fig)
     return path
 

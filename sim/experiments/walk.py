@@ -91,6 +91,17 @@ def walk_marks(world: World, goal: str, trajectory: np.ndarray, distance_m: floa
                      _first(walked * scale, inside & seen[r, c]))
 
 
+def point_at(trajectory: np.ndarray, distance_m: float, at_m: float) -> tuple[float, float]:
+    """The point (x, y m) of ``trajectory`` (rows t s, x m, y m, ...) where the robot had walked ``at_m``, the
+    walk's length counted as ``distance_m`` (the trial's odometry) as :func:`walk_marks` counts it."""
+    poses = np.asarray(trajectory, dtype=float).reshape(len(trajectory), -1)[:, 1:3]
+    walked = np.r_[0.0, np.cumsum(np.hypot(*np.diff(poses, axis=0).T))]
+    scaled = walked * (distance_m / walked[-1]) if walked[-1] > 0 else walked
+    x = np.interp(at_m, scaled, poses[:, 0]) if scaled[-1] > 0 else poses[0, 0]
+    y = np.interp(at_m, scaled, poses[:, 1]) if scaled[-1] > 0 else poses[0, 1]
+    return float(x), float(y)
+
+
 def _first(walked: np.ndarray, hit: np.ndarray) -> float | None:
     """The distance walked (m) at the first true entry of ``hit``, or None."""
     return float(walked[int(np.argmax(hit))]) if hit.any() else None

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim.experiments.walk import PHASES, WalkParams, phase_means, phases, walk_marks
+from sim.experiments.walk import PHASES, WalkParams, phase_means, phases, point_at, walk_marks
 from sim.perception.spotting import SpotParams
 
 
@@ -70,3 +70,28 @@ def test_phases_seen_before_near_leave_no_near_phase_and_means_skip_unmarked_rec
     assert n == 2 and len(means) == len(PHASES)
     assert means == pytest.approx([10.0, 7.5, 2.5])
     assert phase_means([{"distance_m": 5.0}]) is None
+
+
+def test_a_mark_lies_where_the_robot_had_walked_that_far_in_the_trials_own_metres():
+    trajectory, length = walk((0.0, 0.0), (4.0, 0.0), (4.0, 3.0))
+    assert point_at(trajectory, length, 0.0) == pytest.approx((0.0, 0.0))
+    assert point_at(trajectory, length, 5.0) == pytest.approx((4.0, 1.0))
+    assert point_at(trajectory, 2 * length, 5.0) == pytest.approx((2.5, 0.0))  # odometry twice the path
+    assert point_at(trajectory, length, 99.0) == pytest.approx((4.0, 3.0))  # past the end: the end
+
+
+def test_the_picture_shows_where_the_robot_came_near_and_saw_the_label(tiny_world):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from sim.experiments.pictures import WALK_MARKS, draw_walk_marks
+
+    trajectory, length = walk((8.5, 1.0), (8.5, 6.5), (3.0, 6.5), (3.0, 2.5))
+    marks = walk_marks(tiny_world, "A", trajectory, length)
+    fig, ax = plt.subplots()
+    draw_walk_marks(ax, trajectory, length, {"near_at_m": marks.near_at_m, "seen_at_m": None})
+    labels = [line.get_label() for line in ax.get_lines()]
+    plt.close(fig)
+    assert labels == [f"{WALK_MARKS[0][2]}, {marks.near_at_m:.1f} m"]  # a mark never reached is not drawn
