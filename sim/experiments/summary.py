@@ -191,13 +191,14 @@ def summary_markdown(records: list[Record], *, worst: list[Record], pictures: It
     else:
         lines.append("None: every trial found its goal.")
     walks = walk_rows(records, lambda r: (nav(r), r.get("signage") or "-"))
+    walk_header = ["navigator", "signage", *WALK_HEADER]
     if walks:
         lines += ["", "### Where the walking went", "",
                   "Mean metres per trial, split where the robot first came within 8 m (by the floor plan) of a pose "
                   "that reads the goal's label (*far* before it) and where it first saw the label, unread, by the "
                   "spotting rule (`sim/experiments/walk.py`). Metres in the later phases beyond the oracle's last "
                   "few are a search that came close and turned away.", "",
-                  "| " + " | ".join(["navigator", "signage", *WALK_HEADER]) + " |", "|" + " --- |" * 9,
+                  "| " + " | ".join(walk_header) + " |", "|" + " --- |" * len(walk_header),
                   *["| " + " | ".join(row) + " |" for row in walks]]
     lines += ["", "### Per world", ""]
     lines += grouped_table(records, ["world", "style", "signage", "navigator"],

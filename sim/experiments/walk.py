@@ -61,7 +61,7 @@ def walk_marks(world: World, goal: str, trajectory: np.ndarray, distance_m: floa
     as distances walked scaled so that the whole path is ``distance_m`` (the trial's own odometry); ``spot``
     is the spotting rule that says when a label is seen (None: the spotter's own)."""
     spot = spot or SpotParams()
-    poses = np.asarray(trajectory, dtype=float).reshape(len(trajectory), -1)[:, 1:3]
+    poses, walked = _walked(trajectory, distance_m)
     if len(poses) == 0:
         return WalkMarks(None, None)
     labels = world.label_tags(goal)
@@ -85,21 +85,27 @@ def walk_marks(world: World, goal: str, trajectory: np.ndarray, distance_m: floa
     cells = plan.world_to_pixel(poses)
     inside = (cells[:, 0] >= 0) & (cells[:, 0] < rows) & (cells[:, 1] >= 0) & (cells[:, 1] < cols)
     r, c = np.clip(cells[:, 0], 0, rows - 1), np.clip(cells[:, 1], 0, cols - 1)
-    walked = np.r_[0.0, np.cumsum(np.hypot(*np.diff(poses, axis=0).T))]
-    scale = distance_m / walked[-1] if walked[-1] > 0 else 0.0
-    return WalkMarks(_first(walked * scale, inside & (to_go[r, c] <= params.near_m)),
-                     _first(walked * scale, inside & seen[r, c]))
+    return WalkMarks(_first(walked, inside & (to_go[r, c] <= params.near_m)), _first(walked, inside & seen[r, c]))
 
 
 def point_at(trajectory: np.ndarray, distance_m: float, at_m: float) -> tuple[float, float]:
     """The point (x, y m) of ``trajectory`` (rows t s, x m, y m, ...) where the robot had walked ``at_m``, the
     walk's length counted as ``distance_m`` (the trial's odometry) as :func:`walk_marks` counts it."""
-    poses = np.asarray(trajectory, dtype=float).reshape(len(trajectory), -1)[:, 1:3]
+    poses, walked = _walked(trajectory, distance_m)
+    if walked[-1] <= 0:
+        return float(poses[0, 0]), float(poses[0, 1])
+    return float(np.interp(at_m, walked, poses[:, 0])), float(np.interp(at_m, walked, poses[:, 1]))
+
+
+def _walked(trajectory: np.ndarray, distance_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """The poses (N, 2 m) of ``trajectory`` (rows t s, x m, y m, ...) and the distance walked at each (m),
+    scaled so that the whole path is ``distance_m`` (all zero for a path that never moves)."""
+    rows = np.asarray(trajectory, dtype=float)
+    if rows.size == 0:
+        return np.zeros((0, 2)), np.zeros(0)
+    poses = rows.reshape(len(rows), -1)[:, 1:3]
     walked = np.r_[0.0, np.cumsum(np.hypot(*np.diff(poses, axis=0).T))]
-    scaled = walked * (distance_m / walked[-1]) if walked[-1] > 0 else walked
-    x = np.interp(at_m, scaled, poses[:, 0]) if scaled[-1] > 0 else poses[0, 0]
-    y = np.interp(at_m, scaled, poses[:, 1]) if scaled[-1] > 0 else poses[0, 1]
-    return float(x), float(y)
+    return poses, walked * (distance_m / walked[-1]) if walked[-1] > 0 else np.zeros_like(walked)
 
 
 def _first(walked: np.ndarray, hit: np.ndarray) -> float | None:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim.experiments.walk import PHASES, WalkParams, phase_means, phases, point_at, walk_marks
+from sim.experiments.walk import PHASES, WalkMarks, WalkParams, phase_means, phases, point_at, walk_marks
 from sim.perception.spotting import SpotParams
 
 
@@ -51,6 +51,10 @@ def test_a_narrower_spotting_rule_sees_the_label_later(tiny_world):
     narrow = walk_marks(tiny_world, "A", trajectory, length, spot=SpotParams(cone_half_angle_deg=60.0))
     assert wide.seen_at_m is not None and narrow.seen_at_m is not None
     assert narrow.seen_at_m > wide.seen_at_m + 1.0
+
+
+def test_an_empty_walk_is_never_near_and_never_sees(tiny_world):
+    assert walk_marks(tiny_world, "A", np.zeros((0, 4)), 0.0) == WalkMarks(None, None)
 
 
 def test_marks_are_scaled_to_the_trials_own_distance(tiny_world):
