@@ -11,7 +11,21 @@ whose gateway lies within ``gather_m`` of it:
     V(f) = sum over x with |g(x) - f| <= gather_m of b(x)
 
 So the open end of a corridor carries everything the corridor leads to, and a
-room's doorway only the room. Mass on a mapped wall cell (where labels hang)
+room's doorway only the room. But the robot is looking for one label and pays
+for every metre it walks: the search drives to the frontier of least
+``(path + offset) / V`` (belief per metre), and all a corridor leads to is
+worth that much only once the robot has walked to the far end of it. So a
+frontier's worth is the best rate that walking on past it for some distance
+``k`` (``GuideParams.look_ahead_m``) would give:
+
+    V(f) = max over k of M_f(k) (p_f + o) / (p_f + o + k)
+
+with ``M_f(k)`` the mass gathered by ``f`` whose route goes at most ``k`` past
+its gateway, ``p_f`` the route from the robot to the gateway and ``o`` the
+offset: ``(p_f + o) / V(f)`` is then the least metres per unit of belief over
+those walks (a Gittins-style index for one branch of the search), so a plate
+in front of the robot is not outweighed by the sum of all the rooms a corridor
+leads to. Mass on a mapped wall cell (where labels hang)
 counts at the wall's neighbouring cell that the robot reaches first. World
 frame, metres; routes are searched on cells of ``RouteParams.cell_m``.
 """
@@ -41,6 +55,9 @@ class GuideParams:
     floor: float = 1e-6  # a value below this share of the best counts as this (nowhere is ruled out)
     rechoose_s: float = 5.0  # s between choosing the frontier afresh (the evidence changes as the map grows)
     min_target_m: float = 1.0  # m; frontiers nearer than this by path are skipped (the robot sees them as it goes)
+    look_ahead_m: tuple[float, ...] = (0.0, 3.0, 6.0, 12.0, 24.0, 48.0, 96.0)  # m walked past a frontier over which
+    # its worth is the best rate of belief per metre (module docstring): doubling steps from one look (3 m) to
+    # about a building's span; empty: a frontier is worth all the mass behind it, however far
 
 
 def frontier_values(grid: OccupancyGrid, mass: np.ndarray, looked: np.ndarray, robot_xy: np.ndarray,
@@ -68,7 +85,28 @@ def frontier_values(grid: OccupancyGrid, mass: np.ndarray, looked: np.ndarray, r
     flat_unlooked = unlooked.ravel()
     own = np.arange(coarse.size)
     gateway = follow_pointers(np.where(flat_unlooked & flat_unlooked[pred], pred, own))
-    value = np.bincount(gateway, carried, minlength=coarse.size).reshape(blocked.shape)
+    value = _worth(carried, gateway, lengths, pred, blocked, step, params).reshape(blocked.shape)
     reach = max(0, int(round(params.gather_m / step)))
     gathered = ndimage.uniform_filter(value, size=2 * reach + 1, mode="constant") * (2 * reach + 1) ** 2
     return unpool_cells(np.maximum(gathered, 0.0), pool, grid.shape)
+
+
+def _worth(carried: np.ndarray, gateway: np.ndarray, lengths: np.ndarray, pred: np.ndarray, blocked: np.ndarray,
+           step: float, params: GuideParams) -> np.ndarray:
+    """Per route cell (flat), what the mass ``carried`` by the cells whose ``gateway`` it is is worth: all of it
+    with no ``look_ahead_m``, else the best rate over walks of each ``k`` past it (module docstring).
+    ``lengths``, ``pred``: the search from the robot (route cells; walls cost ``WALL_CELLS``); ``step``: m per
+    route cell."""
+    if not params.look_ahead_m:
+        return np.bincount(gateway, carried, minlength=carried.size)
+    own = np.arange(carried.size)
+    opened = follow_pointers(np.where(blocked.ravel(), pred, own))  # a wall cell's open cell, where it is read
+    walked = lengths.ravel()[opened]
+    walked = np.where(np.isfinite(walked), walked, 0.0) * step  # m from the robot (a wall's: to its face)
+    lead = walked + params.offset_m  # m, p_f + o at each gateway
+    past = np.maximum(walked - walked[gateway], 0.0)  # m walked past a cell's gateway to reach it
+    best = np.zeros(carried.size)
+    for k in params.look_ahead_m:
+        within = np.bincount(gateway, np.where(past <= k, carried, 0.0), minlength=carried.size)
+        best = np.maximum(best, within * lead / (lead + k))
+    return best

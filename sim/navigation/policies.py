@@ -503,9 +503,11 @@ class GuidedPolicy(AbstractMapPolicy):
     and the doorways between the start and each place
     (:mod:`sim.navigation.routes`), on mapped walls more than in unseen space,
     and little where the robot has already looked. Each frontier is worth the
-    belief whose route from the robot enters unlooked space through it
+    belief whose route from the robot enters unlooked space through it, as far
+    as a walk on past it gives the best rate of belief per metre
     (:func:`sim.navigation.gateways.frontier_values`), so a corridor's open end
-    carries all it leads to and a room's doorway only the room. Walls seen from
+    carries what lies within reach along it and a room's doorway only the room,
+    and a plate seen stands for the wall around it. Walls seen from
     afar with no plate on them are ruled out, and the space in front of each
     plate seen but not yet read counts as unlooked, so the robot steps in front
     of it (:mod:`sim.navigation.spotted`), and it reads a door's plate before

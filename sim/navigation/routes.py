@@ -31,7 +31,9 @@ inner walls carry only the labels of rooms reached through it. From the start
 (passages narrower than ``door_width_m``) a route must cross to reach the
 space in front of each wall, and weights a label there by ``room_weight`` per
 doorway: corridor-side walls first, through-rooms later, never never.
-World frame, metres.
+A wall takes the likelihoods of the space in front of it too
+(:func:`walls_take_front`): no route enters a wall, but the label on it is read
+from there. World frame, metres.
 """
 
 from __future__ import annotations
@@ -78,7 +80,8 @@ class RouteParams:
     room_weight: float = 0.3  # label weight per doorway crossed: a through-room's label is rarer than a corridor's;
     # with frontiers valued by the belief behind them, development buildings 0-11 found 41 of 60 goals with 0.3
     # against 32 with 0.15 (through rooms 9 of 12 against 3)
-    front_m: float = 1.2  # m; a wall is weighed by the shallowest space this close in front of it
+    front_m: float = 1.2  # m; a wall is weighed by the shallowest and the likeliest space this close in front of it
+    # (door depth; arrows and unnamed signs): a label on it is read from there
     evidence_every_s: float = 8.0  # s between refreshing depth and route evidence (sooner on a new arrow)
     depth_pool: int = 2  # doorways are counted on cells this many times the grid's (0.2 m: a door stays narrow)
 
@@ -191,7 +194,7 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
         near[~np.isfinite(lengths)] = 1.0  # cut off from the reader: the arrow says nothing there
         near[stand] = 1.0
         total *= arrow.wrong_prob + (1.0 - arrow.wrong_prob) * near
-    fine = unpool_cells(total, pool, grid.shape)
+    fine = unpool_cells(walls_take_front(total, blocked, params.front_m / step), pool, grid.shape)
     return fine / float(fine.max())
 
 
@@ -267,8 +270,17 @@ def passed_likelihood(grid: OccupancyGrid, readers: Iterable[tuple[float, float]
             continue  # every route from the start passes a sign beside it: not naming the goal says nothing
         through = near[follow_pointers(np.where(near, np.arange(near.size), pred))].reshape(blocked.shape)
         total *= np.where(through & ~near.reshape(blocked.shape), 1.0 - params.named_prob, 1.0)
-    fine = unpool_cells(total, pool, grid.shape)
+    fine = unpool_cells(walls_take_front(total, blocked, params.front_m / step), pool, grid.shape)
     return fine / float(fine.max())
+
+
+def walls_take_front(likelihood: np.ndarray, blocked: np.ndarray, reach_cells: float) -> np.ndarray:
+    """``likelihood`` (per route cell) with each ``blocked`` cell given the most of the open cells within
+    ``reach_cells`` of it. No route enters a wall, but a label on it is read from the space in front, so it is as
+    likely to be the goal's as a place there; a wall with no open cell that near keeps its own."""
+    reach = max(1, int(round(reach_cells)))
+    front = ndimage.maximum_filter(np.where(blocked, -np.inf, likelihood), size=2 * reach + 1, mode="nearest")
+    return np.where(blocked & np.isfinite(front), front, likelihood)
 
 
 def first_leg_points(lengths: np.ndarray, pred: np.ndarray, lead: float) -> np.ndarray:

@@ -13,7 +13,9 @@ read, and gives the guided search three grids (the occupancy grid's cells):
 - ``zones``: for each unread plate, the free space in front of it from which it
   is read (square to it, 1.2-3 m out): the search treats that space as not yet
   looked at, so a frontier forms there and carries the plate's belief, and the
-  robot drives to stand in front of it;
+  robot drives to stand in front of it. A label hangs only on a plate, so a
+  plate stands for the wall around it that a label could have hung on
+  (``plate_wall_m``), and its zone is worth the belief along that much wall;
 - ``door_stop``: where to read the first unread plate beside a doorway that a
   planned path is about to pass through into the space behind the plate. A
   door's plate hangs beside it facing the way the door is approached and names
@@ -55,6 +57,10 @@ class SpottedParams:
     # door: a door's width (about 1 m) plus the plate's offset from its jamb
     read_at_m: float = 2.0  # m out along a plate's normal where the robot stops to read it before its door:
     # the middle of the reading zone
+    plate_wall_m: float = 26.0  # m of wall a plate seen stands for: a label hangs only on a plate, so a plate is
+    # worth the belief along the wall a plate stands for, not only on its own half metre. Development buildings
+    # 100-147 have 24.9-27.9 m of reachable wall face per plate (docs/method-notes.md, "A plate stands for the
+    # wall around it"); valued so, plates are weighed by the arrows too (RouteParams.front_m)
 
 
 class SpottedTags:
@@ -126,10 +132,11 @@ class SpottedTags:
 
     def zone_values(self, grid: OccupancyGrid, mass: np.ndarray) -> np.ndarray:
         """Per cell, the belief ``mass`` (the grid's shape) on the plate whose reading zone holds it (the most,
-        where zones overlap): what standing there would read."""
+        where zones overlap), times ``plate_wall_m`` over the plate's width: what standing there would read."""
         out = np.zeros(grid.shape)
+        worth = max(1.0, self.params.plate_wall_m / (2.0 * self.params.tag_radius_m))
         for _, rows, cols, zone, d in self._zone_blocks(grid):
-            on_plate = float(mass[rows, cols][d <= self.params.tag_radius_m].sum())
+            on_plate = float(mass[rows, cols][d <= self.params.tag_radius_m].sum()) * worth
             out[rows, cols] = np.maximum(out[rows, cols], np.where(zone, on_plate, 0.0))
         return out
 

@@ -16,6 +16,7 @@ from sim.navigation.routes import (
     passed_likelihood,
     path_sums,
     route_likelihood,
+    walls_take_front,
 )
 
 
@@ -196,3 +197,22 @@ def test_an_arrow_against_a_route_across_unseen_space_does_not_rule_its_place_ou
     assert at(grid, route_likelihood(grid, [west]), *place) > 0.4
     along_the_mapped_corridor = (16.0, 1.0)  # east of the reader over mapped floor: the arrow still rules it out
     assert at(grid, route_likelihood(grid, [west]), *along_the_mapped_corridor) < 0.15
+
+
+def test_a_wall_takes_the_likeliest_space_in_front_of_it():
+    """No route enters a wall, but a label on it is read from the space in front: a corridor's north wall
+    behind the sign's reader (west, against an arrow east) is as unlikely as the corridor there, and the wall
+    ahead as likely (the wall is the building's edge: nothing lies beyond it)."""
+    grid = grid_of([(0.0, 20.0, 3.0, 3.2)], size=(20.0, 3.2))
+    east = Arrow(sign_xy=(10.0, 1.0), facing=math.pi / 2, direction=0.0, wrong_prob=0.1)
+    likelihood = route_likelihood(grid, [east])
+    assert at(grid, likelihood, 3.0, 3.1) == pytest.approx(at(grid, likelihood, 3.0, 2.5), abs=0.02)
+    assert at(grid, likelihood, 3.0, 3.1) < 0.15
+    assert at(grid, likelihood, 17.0, 3.1) == pytest.approx(1.0, abs=0.05)
+
+
+def test_walls_far_from_open_space_keep_their_own_likelihood():
+    likelihood = np.array([[0.2, 0.9, 0.5, 0.5, 0.5]])
+    blocked = np.array([[False, True, True, True, True]])
+    out = walls_take_front(likelihood, blocked, 1.0)
+    assert out.tolist() == [[0.2, 0.2, 0.5, 0.5, 0.5]]

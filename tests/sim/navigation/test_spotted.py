@@ -41,16 +41,18 @@ def test_a_plates_reading_zone_lies_in_front_of_it_inside_the_reading_cone():
     assert not np.any(zones & grid.occupied_mask())
 
 
-def test_a_zone_is_worth_the_belief_on_its_plate():
+@pytest.mark.parametrize("plate_wall_m", [0.5, 10.0])
+def test_a_zone_is_worth_the_belief_on_its_plate_times_the_wall_it_stands_for(plate_wall_m):
     grid = grid_of(WALL)
-    tags = SpottedTags()
+    tags = SpottedTags(SpottedParams(plate_wall_m=plate_wall_m))
     tags.update([], [PLATE])
     mass = np.zeros(grid.shape)
     plate = tags.tag_cells(grid)
     mass[plate] = 0.5 / plate.sum()
     mass[grid.world_to_cell(np.array([3.0, 4.1]))[0][0], grid.world_to_cell(np.array([3.0, 4.1]))[0][1]] = 0.5
     values = tags.zone_values(grid, mass)
-    assert at(grid, values, 10.0, 2.0) == pytest.approx(0.5)
+    worth = plate_wall_m / (2 * tags.params.tag_radius_m)  # a plate 0.5 m wide stands for plate_wall_m of wall
+    assert at(grid, values, 10.0, 2.0) == pytest.approx(0.5 * worth)
     assert at(grid, values, 3.0, 2.0) == 0.0
     assert 2 <= plate.sum() <= 30  # a disc of 0.25 m on 0.1 m cells
 
