@@ -19,9 +19,9 @@ differs is where it wants to go. Register a new one in :data:`NAVIGATORS`.
   cues say little (see ``docs/method-notes.md``).
 - ``guided``: a frontier search like ``frontier``'s, reading signs: the frontier
   with the most of that goal belief behind it per metre of path, counted as far
-  past it as a walk there pays (:mod:`sim.navigation.gateways`), ruling out walls seen from afar without a
-  plate and stepping in front of plates seen but unread
-  (:mod:`sim.navigation.spotted`).
+  past it as a walk there pays (:mod:`sim.navigation.gateways`), ruling out
+  walls seen from afar without a plate and stepping in front of plates seen but
+  unread (:mod:`sim.navigation.spotted`).
 """
 
 from __future__ import annotations
