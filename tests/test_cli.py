@@ -13,7 +13,7 @@ from abstract_map import cli
 
 def test_every_package_contributes_its_subcommands():
     found = cli.commands()
-    assert {"imagine", "trial", "study"} <= set(found)
+    assert {"imagine", "trial", "study", "compare"} <= set(found)
     assert all(isinstance(m, types.ModuleType) for m in found.values())
 
 
