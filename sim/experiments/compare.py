@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from sim.experiments.walk import PHASES, phases
+from sim.experiments.walk import PHASES, phase_means
 
 Record = dict[str, Any]
 Key = tuple[Any, ...]
@@ -136,9 +136,8 @@ def _row(group: str, pairs: list[tuple[Record, Record]]) -> Row:
 
 def _phase_means(records: list[Record]) -> tuple[float, ...] | None:
     """Mean metres per found trial in each of PHASES, over the found records that carry the walk's marks."""
-    split = [phases(float(r["distance_m"]), r["near_at_m"], r["seen_at_m"]) for r in records
-             if r["success"] and "near_at_m" in r and "seen_at_m" in r]
-    return tuple(float(v) for v in np.mean(split, axis=0)) if split else None
+    means = phase_means(r for r in records if r["success"])
+    return None if means is None else tuple(means[1])
 
 
 def markdown(result: Comparison, base_name: str, new_name: str) -> str:
