@@ -5,7 +5,8 @@ to what it names (the convention of ``worlds/README.md``, which ``world check``
 tests to within 45 degrees, the reader standing 1 m in front of the sign). So
 a cell ``x`` is consistent with the arrow when its shortest route from the
 reader's spot ``s`` sets off along the arrow: with ``q(x)`` the point where
-that route (over the robot's map: mapped walls block, unseen space is open)
+that route (over the robot's map: mapped walls block, unseen space is open but
+dearer, ``unseen_cost`` a metre against 1 over mapped floor, :func:`route_costs`)
 first leaves the circle of radius ``lead_m`` about ``s``,
 
     error(x) = | angle(q(x) - s) - arrow |    (the first leg's direction against the arrow)
@@ -23,7 +24,10 @@ planned across unseen space may be wrong about its first leg (walls not yet
 seen can turn it), so a cell whose first leg misses the arrow keeps
 ``exp(-detour / (unseen_detour * unseen))`` instead when that is more: how much
 longer a route is that sets off along the arrow, against how much of its own
-route near the reader crosses unseen space (``_unseen_way``).
+route near the reader crosses unseen space (``_unseen_way``). Lengths here are
+priced as the routes are (unseen metres cost ``unseen_cost``), so the detour
+allowed is ``unseen_detour / unseen_cost`` of the unseen length, and the lead and
+``unseen_reach_m`` shrink by that price across unseen space.
 
 Labels hang beside doors on the side a door is approached from, so a room's
 inner walls carry only the labels of rooms reached through it. From the start
@@ -63,6 +67,10 @@ class RouteParams:
     # may take its diagonal steps first, so a first leg read off the grid can lie up to 22.5 deg off its line
     unseen_detour: float = 0.41  # share of a route's length across unseen space by which the true route may be
     # longer: round a square block rather than across its diagonal (sqrt 2 - 1); see route_likelihood
+    unseen_cost: float = 1.41  # route cost per metre across unseen space against 1 over mapped free space (arrows
+    # and unnamed signs): a route planned straight across a block not yet seen is in truth longer by
+    # ``unseen_detour`` (round it, not across its diagonal), so routes keep to mapped floor where it serves as well.
+    # Measured on development buildings, 600 trials (docs/method-notes.md, "What the robot's own map costs")
     unseen_reach_m: float = 15.0  # m from the reader within which unseen space can turn a route's first leg: the
     # walls of about one block between corridors (10-20 m in most buildings)
     wrong_prob: float = 0.1  # chance an arrow naming the goal is wrong ("misleading" signage: one in ten)
@@ -147,6 +155,12 @@ def route_cells(grid: OccupancyGrid, params: RouteParams) -> tuple[int, np.ndarr
     return pool, pool_cells(grid.occupied_mask(), pool, False, np.any)
 
 
+def route_costs(blocked: np.ndarray, unseen: np.ndarray, params: RouteParams) -> np.ndarray:
+    """Per route cell, what a route pays to cross it: inf through a wall, ``unseen_cost`` across unseen space,
+    1 over mapped free space."""
+    return np.where(blocked, np.inf, np.where(unseen, params.unseen_cost, 1.0))
+
+
 def open_cell(grid: OccupancyGrid, pool: int, blocked: np.ndarray, xy: np.ndarray) -> tuple[int, int] | None:
     """The open cell of ``blocked`` (``grid``'s cells pooled ``pool`` x ``pool``) nearest to ``xy`` (m), or None
     when it has none."""
@@ -169,9 +183,9 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
     if not arrows:
         return None
     pool, blocked = route_cells(grid, params)
-    costs = np.where(blocked, np.inf, 1.0)
-    step = pool * grid.resolution
     unseen = pool_cells(grid.unknown_mask().astype(np.float32), pool, np.float32(1.0), np.mean) > 0.5
+    costs = route_costs(blocked, unseen, params)
+    step = pool * grid.resolution
     total = np.ones(blocked.shape)
     tolerance, spread = math.radians(params.tolerance_deg), math.radians(params.spread_deg)
     for arrow in arrows:
@@ -203,11 +217,11 @@ def _unseen_way(lengths: np.ndarray, pred: np.ndarray, along: np.ndarray, costs:
     """Per route cell, how likely its true route from the reader sets off along the arrow although its shortest
     route over the robot's map does not: ``exp(-detour / (share * across))``, with ``detour`` how much longer (in
     cells) the shortest route is that leaves the reader's circle of ``lead`` cells where the arrow points
-    (``along``: each cell's first leg lies within the tolerance; the route may not come back through the circle)
-    and ``across`` the cells of the shortest route that lie in ``unseen`` space (those near enough the reader to
-    turn its first leg). A route over mapped space is what it is (0 where ``across`` is 0); one across unseen
-    space may be longer in truth by up to ``share`` of that. Cells within the circle get 0: their first leg is
-    the test."""
+    (``along``: each cell's first leg lies within the tolerance; the route may not come back through the circle;
+    lengths as priced by ``costs``) and ``across`` the cells of the shortest route that lie in ``unseen`` space
+    (those near enough the reader to turn its first leg). A route over mapped space is what it is (0 where
+    ``across`` is 0); one across unseen space may be longer in truth by up to ``share`` of that. Cells within the
+    circle get 0: their first leg is the test."""
     flat = lengths.ravel()
     inside = flat <= lead
     rim = inside & (flat > lead - 1.5) & along.ravel()  # within one diagonal step (1.41 cells) of the circle's edge
@@ -243,9 +257,9 @@ def passed_likelihood(grid: OccupancyGrid, readers: Iterable[tuple[float, float]
                       params: RouteParams = RouteParams(), searches: PathSearches | None = None) -> np.ndarray | None:
     """Per cell of ``grid``, the likelihood that signs read at ``readers`` (where each sign's reader stands, m)
     named neither the goal nor an area holding it, given the goal there: ``1 - named_prob`` where the cell's
-    shortest route from ``start_xy`` (m; over the robot's map, unseen space open) passes within ``junction_m``
-    of a reader and ends beyond it, 1 elsewhere (a reader that near the start says nothing); scaled to a peak of
-    1; None with no reader.
+    shortest route from ``start_xy`` (m; over the robot's map, unseen space open at ``unseen_cost``) passes within
+    ``junction_m`` of a reader and ends beyond it, 1 elsewhere (a reader that near the start says nothing); scaled
+    to a peak of 1; None with no reader.
 
     Signs name the places whose routes pass them, so a sign that does not name the goal says the goal lies off
     the ways it stands on."""
@@ -257,7 +271,8 @@ def passed_likelihood(grid: OccupancyGrid, readers: Iterable[tuple[float, float]
     start = open_cell(grid, pool, blocked, np.asarray(start_xy, dtype=float))
     if start is None:
         return None
-    lengths, pred = searches.tree("route", np.where(blocked, np.inf, 1.0), start)
+    unseen = pool_cells(grid.unknown_mask().astype(np.float32), pool, np.float32(1.0), np.mean) > 0.5
+    lengths, pred = searches.tree("route", route_costs(blocked, unseen, params), start)
     step = pool * grid.resolution
     rows, cols = np.indices(blocked.shape)
     x0, y0 = grid.origin

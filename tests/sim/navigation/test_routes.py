@@ -173,6 +173,24 @@ def test_a_sign_not_naming_the_goal_says_nothing_of_a_branch_the_route_leaves_be
     assert at(grid, likelihood, 8.0, 1.0) == pytest.approx(1.0)
 
 
+def test_routes_keep_to_the_mapped_corridors_when_unseen_space_costs_more():
+    """Two mapped corridors, east along y 0 .. 2 and north along x 10 .. 12; everything else unseen. A sign not
+    naming the goal has its reader at (11, 5) in the northern one. From the start (1, 1), the shortest route to a
+    place at (11, 9) over unseen space as cheap as mapped floor cuts across the unseen block, clear of the
+    reader: the sign says nothing of the place. With unseen space dear enough (``unseen_cost``) the route keeps to
+    the corridors, past the reader, and the place beyond the sign is discounted."""
+    grid = grid_of([], (14.0, 14.0))
+    xy = grid.cell_to_world(np.argwhere(np.ones(grid.shape, dtype=bool)))
+    cells = grid.world_to_cell(xy)
+    corridors = (xy[:, 1] < 2.0) | ((xy[:, 0] >= 10.0) & (xy[:, 0] < 12.0))
+    grid.log_odds[cells[~corridors, 0], cells[~corridors, 1]] = 0.0
+    reader, start, place = [(11.0, 5.0)], np.array([1.0, 1.0]), (11.0, 9.0)
+    dear = RouteParams(unseen_cost=2.0)
+    assert at(grid, passed_likelihood(grid, reader, start, dear), *place) == pytest.approx(1.0 - dear.named_prob)
+    cheap = RouteParams(unseen_cost=1.0)
+    assert at(grid, passed_likelihood(grid, reader, start, cheap), *place) == pytest.approx(1.0)
+
+
 def test_path_sums_add_up_each_index_and_its_ancestors():
     pred = np.array([0, 0, 1, 2, 3, 5])  # a chain 4 -> 3 -> 2 -> 1 -> 0 (the root), and 5 on its own
     sums = path_sums(pred, np.array([7.0, 1.0, 2.0, 3.0, 4.0, 9.0]))
@@ -184,7 +202,9 @@ def test_an_arrow_against_a_route_across_unseen_space_does_not_rule_its_place_ou
     the corridor and its wall up to x 10; beyond, and north of the wall, nothing. Over that map the shortest route
     to a place far to the north-east sets off east and crosses the unseen wall, against the arrow west (which is
     right: the true route takes the gap). A route that sets off west is only a little longer across the same
-    unseen space, so the place stays likely; by the first leg alone it would not."""
+    unseen space, so the place stays likely; by the first leg alone it would not. The detour is priced as routes
+    are (``unseen_cost`` a metre across unseen space), so the allowance is less than with unseen space as cheap
+    as mapped floor, but the place stays well above the wrong arrow's 0.1."""
     size = (20.0, 30.0)
     west = Arrow(sign_xy=(8.0, 0.0), facing=math.pi / 2, direction=math.pi, wrong_prob=0.1)
     grid = grid_of([(0.0, 2.0, 2.0, 2.2), (4.0, 20.0, 2.0, 2.2)], size)
@@ -194,7 +214,8 @@ def test_an_arrow_against_a_route_across_unseen_space_does_not_rule_its_place_ou
     grid.log_odds[cells[unseen, 0], cells[unseen, 1]] = 0.0
     place = (14.0, 25.0)
     assert at(grid, route_likelihood(grid, [west], RouteParams(unseen_detour=0.0)), *place) < 0.15
-    assert at(grid, route_likelihood(grid, [west]), *place) > 0.4
+    assert at(grid, route_likelihood(grid, [west], RouteParams(unseen_cost=1.0)), *place) > 0.4
+    assert at(grid, route_likelihood(grid, [west]), *place) > 0.25  # priced: the detour weighs unseen_cost more
     along_the_mapped_corridor = (16.0, 1.0)  # east of the reader over mapped floor: the arrow still rules it out
     assert at(grid, route_likelihood(grid, [west]), *along_the_mapped_corridor) < 0.15
 
