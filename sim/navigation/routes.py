@@ -155,6 +155,11 @@ def route_cells(grid: OccupancyGrid, params: RouteParams) -> tuple[int, np.ndarr
     return pool, pool_cells(grid.occupied_mask(), pool, False, np.any)
 
 
+def unseen_cells(grid: OccupancyGrid, pool: int) -> np.ndarray:
+    """The route cells (``grid``'s cells pooled ``pool`` x ``pool``) mostly unseen: bool."""
+    return pool_cells(grid.unknown_mask().astype(np.float32), pool, np.float32(1.0), np.mean) > 0.5
+
+
 def route_costs(blocked: np.ndarray, unseen: np.ndarray, params: RouteParams) -> np.ndarray:
     """Per route cell, what a route pays to cross it: inf through a wall, ``unseen_cost`` across unseen space,
     1 over mapped free space."""
@@ -183,7 +188,7 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
     if not arrows:
         return None
     pool, blocked = route_cells(grid, params)
-    unseen = pool_cells(grid.unknown_mask().astype(np.float32), pool, np.float32(1.0), np.mean) > 0.5
+    unseen = unseen_cells(grid, pool)
     costs = route_costs(blocked, unseen, params)
     step = pool * grid.resolution
     total = np.ones(blocked.shape)
@@ -271,7 +276,7 @@ def passed_likelihood(grid: OccupancyGrid, readers: Iterable[tuple[float, float]
     start = open_cell(grid, pool, blocked, np.asarray(start_xy, dtype=float))
     if start is None:
         return None
-    unseen = pool_cells(grid.unknown_mask().astype(np.float32), pool, np.float32(1.0), np.mean) > 0.5
+    unseen = unseen_cells(grid, pool)
     lengths, pred = searches.tree("route", route_costs(blocked, unseen, params), start)
     step = pool * grid.resolution
     rows, cols = np.indices(blocked.shape)
