@@ -221,10 +221,10 @@ def _unseen_way(lengths: np.ndarray, pred: np.ndarray, along: np.ndarray, costs:
                 lead: float, share: float, searches: PathSearches, kind: str) -> np.ndarray:
     """Per route cell, how likely its true route from the reader sets off along the arrow although its shortest
     route over the robot's map does not: ``exp(-detour / (share * across))``, with ``detour`` how much longer (in
-    cells) the shortest route is that leaves the reader's circle of ``lead`` cells where the arrow points
-    (``along``: each cell's first leg lies within the tolerance; the route may not come back through the circle;
-    lengths as priced by ``costs``) and ``across`` the cells of the shortest route that lie in ``unseen`` space
-    (those near enough the reader to turn its first leg). A route over mapped space is what it is (0 where
+    cells, priced by ``costs``) the shortest route is that leaves the reader's circle of ``lead`` cells where the
+    arrow points (``along``: each cell's first leg lies within the tolerance; the route may not come back through
+    the circle) and ``across`` the cells of the shortest route that lie in ``unseen`` space (those near enough the
+    reader to turn its first leg). A route over mapped space is what it is (0 where
     ``across`` is 0); one across unseen space may be longer in truth by up to ``share`` of that. Cells within the
     circle get 0: their first leg is the test."""
     flat = lengths.ravel()
