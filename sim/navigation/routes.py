@@ -224,9 +224,9 @@ def _unseen_way(lengths: np.ndarray, pred: np.ndarray, along: np.ndarray, costs:
     cells, priced by ``costs``) the shortest route is that leaves the reader's circle of ``lead`` cells where the
     arrow points (``along``: each cell's first leg lies within the tolerance; the route may not come back through
     the circle) and ``across`` the cells of the shortest route that lie in ``unseen`` space (those near enough the
-    reader to turn its first leg). A route over mapped space is what it is (0 where
-    ``across`` is 0); one across unseen space may be longer in truth by up to ``share`` of that. Cells within the
-    circle get 0: their first leg is the test."""
+    reader to turn its first leg). A route over mapped space is what it is (0 where ``across`` is 0); one across
+    unseen space may be longer in truth by up to ``share`` of that. Cells within the circle get 0: their first leg
+    is the test."""
     flat = lengths.ravel()
     inside = flat <= lead
     rim = inside & (flat > lead - 1.5) & along.ravel()  # within one diagonal step (1.41 cells) of the circle's edge
