@@ -22,6 +22,9 @@ differs is where it wants to go. Register a new one in :data:`NAVIGATORS`.
   past it as a walk there pays (:mod:`sim.navigation.gateways`), ruling out
   walls seen from afar without a plate and stepping in front of plates seen but
   unread (:mod:`sim.navigation.spotted`).
+- ``known-goal``: ``guided`` with the goal's prior on its true label (the
+  world's truth): the reference of a search that knows where the goal is but
+  not the building (a ceiling in practice), beside ``frontier``'s lower bound.
 """
 
 from __future__ import annotations
@@ -612,11 +615,38 @@ class GuidedPolicy(AbstractMapPolicy):
         return covered | seen.swept if seen is not None and seen.swept.shape == covered.shape else covered
 
 
+class KnownGoalPolicy(GuidedPolicy):
+    """``guided`` told where the goal's label hangs: an informed reference, not a navigator for unseen buildings.
+
+    The goal's prior sits on the label the oracle reads first from the start (the
+    world's truth, :func:`sim.world.oracle.oracle_path`) with spread
+    ``GuideParams.known_spread_m``; everything else is the guided search's, over
+    a building the robot still has to map. What it walks beyond the oracle is
+    what not knowing the building costs this search; what ``guided`` walks
+    beyond it is what not knowing where the goal is costs (``docs/method-notes.md``,
+    "The ceiling of a known goal").
+    """
+
+    def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
+        super().__init__(world, goal, start, params)
+        from sim.world.oracle import oracle_path  # the truth: only this baseline may ask it
+
+        try:
+            tag = world.tags[oracle_path(world, goal, (start[0], start[1])).tag_id]
+        except ValueError:  # a start within the robot's radius of a wall: the world's own start
+            tag = world.tags[oracle_path(world, goal).tag_id]
+        self.label_xy = np.array([tag.x, tag.y], dtype=float)
+
+    def goal_prior(self) -> GoalPrior:
+        return GoalPrior(self.label_xy, self.params.guide.known_spread_m, self.family_labels())
+
+
 NAVIGATORS: dict[str, type] = {
     "paper": PaperPolicy,
     "frontier": FrontierPolicy,
     "viewpoint": ViewpointPolicy,
     "guided": GuidedPolicy,
+    "known-goal": KnownGoalPolicy,
 }
 """Every navigation policy by its ``--navigator`` name; each is built as ``cls(world, goal, start, params)``."""
 

@@ -7,7 +7,7 @@ import pytest
 from sim.experiments.trial import run_trial
 from sim.navigation.policies import NAVIGATORS
 
-SEARCHERS = ["viewpoint", "guided"]  # the navigators that keep a belief or evidence layer and a swept layer
+SEARCHERS = ["viewpoint", "guided", "known-goal"]  # the navigators that keep a belief layer and a swept layer
 
 
 def test_searchers_are_navigators_beside_paper():
@@ -144,3 +144,24 @@ def test_plates_are_spotted_only_for_a_navigator_that_takes_them_in(tiny_world, 
 
     with Trial(tiny_world, "A", perception="geometric", navigator=navigator) as trial:
         assert (trial.spotter is not None) == spots
+
+
+def test_known_goal_puts_its_prior_on_the_label_the_oracle_reads(tmp_path):
+    """The informed reference's prior is the truth (the oracle's label, known_spread_m), not the model's."""
+    import numpy as np
+
+    from sim.experiments.trial import TrialParams, policy_params
+    from sim.navigation.policies import KnownGoalPolicy
+    from sim.world.data import load_world
+    from sim.world.generator import generated_world
+    from sim.world.oracle import oracle_path
+
+    world = load_world(generated_world(3, style="office", size="small", signage="complete", root=tmp_path))
+    params = policy_params(TrialParams())
+    for goal in sorted(world.goals)[:2]:
+        policy = KnownGoalPolicy(world, goal, world.start, params)
+        tag = world.tags[oracle_path(world, goal).tag_id]
+        prior = policy.goal_prior()
+        assert np.allclose(prior.centre, (tag.x, tag.y))
+        assert prior.sigma_m == params.guide.known_spread_m
+        assert float(np.hypot(*(policy.nav.model.goal_estimate() - prior.centre))) > 0.5  # not the model's
