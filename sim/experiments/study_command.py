@@ -43,7 +43,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--trials", type=int, default=5, help="trials per goal and navigator (default 5)")
     parser.add_argument("--navigator", action="append", metavar="NAME",
                         help="paper (default; the paper's robot), frontier (reads no sign), viewpoint "
-                             "(negative information) and/or guided (frontiers by the goal belief behind them); "
+                             "(negative information), guided (frontiers by the goal belief behind them) and/or "
+                             "known-goal (guided told where the goal's label hangs: an informed reference); "
                              "repeatable or a comma list, to compare them side by side")
     parser.add_argument("--workers", type=int, default=2, help="parallel trials (default 2)")
     parser.add_argument("--perception", default="camera", choices=["camera", "geometric"])

@@ -42,9 +42,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--navigator", default="paper",
                         help="navigation policy: paper (the paper's robot, reads signs; default), frontier "
                              "(nearest frontier, reads no sign: the no-signs lower bound), viewpoint (negative "
-                             "information: to where the goal's label may still be read) or guided (the frontier "
+                             "information: to where the goal's label may still be read), guided (the frontier "
                              "with the best rate of goal belief per metre walked past it, from the arrows, signs, "
-                             "doorways and abstract map; it reads the plates it sees from afar)")
+                             "doorways and abstract map; it reads the plates it sees from afar) or known-goal "
+                             "(guided told where the goal's label hangs: an informed reference, not for unseen "
+                             "buildings)")
     parser.add_argument("--out", type=Path, required=True, help="output folder")
     parser.add_argument("--record", action="store_true", help="also write DIR/run.gif, an animation of the run")
     parser.add_argument("--log", type=Path, metavar="FILE.rrd",
