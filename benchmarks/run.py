@@ -185,12 +185,13 @@ TEST_SEED = 1000  # the first test building: seeds 1000-1999 are for reporting o
 
 
 def generalise_tables(records: list[dict], title: str) -> None:
-    """Success, SPL, ratio to oracle and wall time per navigator and signage level, then per style."""
+    """Success, SPL, ratio to oracle and wall time per navigator and signage level, then per style, then per
+    goal role (why the generator chose the goal: ``goal_roles``)."""
     from sim.experiments.summary import stats
 
     header = ["perception", "navigator", "{}", "trials", "success", "SPL", "ratio to oracle", "wall per trial (s)",
               "CPU per trial (s)", "wall in all (min)"]  # costs count a shared run once (run_cost)
-    for column in ("signage", "style"):
+    for column in ("signage", "style", "role"):
         groups: dict[tuple[str, str, str], list[dict]] = {}
         for record in records:
             for value in (record.get(column) or "-", "all"):

@@ -97,7 +97,8 @@ def pair_key(record: Record, with_navigator: bool) -> Key:
 def compare(base: Sequence[Record], new: Sequence[Record], *, groups: Sequence[str] = GROUPS,
             with_navigator: bool = True) -> Comparison:
     """Pair ``base`` and ``new`` trial by trial (:data:`PAIR_FIELDS`, and the navigator if ``with_navigator``)
-    and compare every group: all, then each value of each field in ``groups`` (taken from the base record).
+    and compare every group: all, then each value of each field in ``groups`` (taken from the base record, or
+    the new one where the base has none: a study run before the field was recorded).
     :class:`CompareError` when a side repeats a trial or no trial is shared."""
     by_base, by_new = _index(base, with_navigator, "base"), _index(new, with_navigator, "new")
     shared = sorted(set(by_base) & set(by_new), key=repr)
@@ -106,9 +107,19 @@ def compare(base: Sequence[Record], new: Sequence[Record], *, groups: Sequence[s
     pairs = [(by_base[k], by_new[k]) for k in shared]
     rows = [_row("all", pairs)]
     for field in groups:
-        values = sorted({str(b.get(field)) for b, _ in pairs})
-        rows += [_row(f"{field}={v}", [p for p in pairs if str(p[0].get(field)) == v]) for v in values]
+        values = sorted({_group_value(p, field) for p in pairs})
+        rows += [_row(f"{field}={v}", [p for p in pairs if _group_value(p, field) == v]) for v in values]
     return Comparison(rows, sorted(set(by_base) - set(by_new), key=repr), sorted(set(by_new) - set(by_base), key=repr))
+
+
+def _group_value(pair: tuple[Record, Record], field: str) -> str:
+    """The pair's value of ``field``: the base record's, else the new one's; "-" when neither has one (None and
+    "" count as none)."""
+    base, new = pair
+    value = base.get(field)
+    if value in (None, ""):
+        value = new.get(field)
+    return "-" if value in (None, "") else str(value)
 
 
 def _index(records: Sequence[Record], with_navigator: bool, side: str) -> dict[Key, Record]:

@@ -27,7 +27,7 @@ from abstract_map.files import write_text_atomic
 
 SUMMARY = "compare two studies trial by trial: change of success and SPL with its standard error (needs [sim])"
 EXTRA = "sim"  # the optional dependencies it needs
-FIELDS = ("signage", "style", "world", "goal", "navigator", "perception", "seed")  # what --by may name
+FIELDS = ("signage", "style", "role", "world", "goal", "navigator", "perception", "seed")  # what --by may name
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

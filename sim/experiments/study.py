@@ -34,7 +34,7 @@ from sim.experiments.metrics import oracle_ratio, spl
 from sim.experiments.trial import TrialParams
 from sim.world.data import World
 
-CSV_FIELDS = ["world", "style", "signage", "navigator", "goal", "seed", "perception", "success", "reason",
+CSV_FIELDS = ["world", "style", "signage", "navigator", "goal", "role", "seed", "perception", "success", "reason",
               "explanation", "distance_m", "oracle_m", "spl", "near_at_m", "seen_at_m", "sim_s", "wall_s", "cpu_s"]
 SETTINGS_FILE = "settings.json"
 SETTINGS_FORMAT = "abstract-map-study/2"
@@ -64,6 +64,8 @@ class TrialSpec:
     oracle_m: float | None = None  # m, the oracle's length from the (un-jittered) start
     style: str = ""  # a generated world's style and signage level ("" for others)
     signage: str = ""
+    role: str = ""  # why the generator chose this goal (world.json's ``goal_roles``: "hall", "dead end", ...;
+    # "" for others)
 
     @property
     def name(self) -> str:
@@ -142,12 +144,12 @@ def run_unit(unit: tuple[TrialSpec, ...]) -> list[dict[str, Any]]:
 
 
 def label_record(record: dict[str, Any], spec: TrialSpec) -> dict[str, Any]:
-    """The record with its study key and scores: world, navigator, style, signage, oracle_m, spl, ratio."""
+    """The record with its study key and scores: world, navigator, style, signage, role, oracle_m, spl, ratio."""
     distance = record.get("distance_m")
     score = spl(record["success"], distance, spec.oracle_m)
     ratio = oracle_ratio(record["success"], distance, spec.oracle_m)
     return {**record, "world": spec.name, "navigator": spec.navigator, "style": spec.style,
-            "signage": spec.signage, "oracle_m": spec.oracle_m,
+            "signage": spec.signage, "role": spec.role, "oracle_m": spec.oracle_m,
             "spl": None if score is None else round(score, 4),
             "oracle_ratio": None if ratio is None else round(ratio, 4)}
 
@@ -240,7 +242,7 @@ def plan_specs(world: World, trials: int, perception: str, *, base: TrialParams 
     oracle_m = oracle_m or {}
     return [TrialSpec(str(world.root), goal, seed, perception, params, navigator=navigator, world_name=world.name,
                       oracle_m=oracle_m.get(goal), style=str(made.get("style", "")),
-                      signage=str(made.get("signage", "")))
+                      signage=str(made.get("signage", "")), role=str(made.get("goal_roles", {}).get(goal, "")))
             for goal in chosen for navigator in dict.fromkeys(navigators) for seed in range(trials)]
 
 
@@ -308,8 +310,9 @@ def _load_record(path: Path, spec: TrialSpec) -> dict[str, Any] | None:
     if not isinstance(record, dict) or "success" not in record:
         return None
     mine = (spec.name, spec.navigator, spec.goal, spec.seed)
-    return record if (record.get("world"), record.get("navigator"), record.get("goal"), record.get("seed")) == mine \
-        else None
+    if (record.get("world"), record.get("navigator"), record.get("goal"), record.get("seed")) != mine:
+        return None
+    return {"role": spec.role, **record}  # a record written before roles were recorded takes its spec's
 
 
 def run_study(specs: list[TrialSpec], out: Path, *, executor: ProcessExecutor | RayExecutor,

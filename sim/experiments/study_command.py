@@ -15,12 +15,12 @@ DIR/worlds/. Seeds 0-999 are for development; 1000-1999 are test buildings, for 
 
 Trials differ by seed: start-pose jitter (0.10 m, 3 deg), the recovery's turning direction and, in
 geometric mode, detection noise (0.03 m, 1 deg). Writes DIR/settings.json, DIR/trials/ (one JSON per
-trial), DIR/trials.csv (world, style, signage, navigator, goal, seed, perception, success, reason, explanation,
-distance_m, oracle_m, spl, sim_s, wall_s, cpu_s), DIR/report.md (success rate, SPL, ratio to the oracle and
-failures by reason: overall, per navigator, style, signage level and world; the ten worst trials with
-pictures in DIR/worst/) and, for the zoo, the paper's Table I extended, DIR/comparison.png (box plots
-like the paper's Fig. 11) and DIR/paths/GOAL.png. Run again on the same DIR to resume (across worlds):
-finished trials are skipped; other settings on the same DIR are refused.
+trial), DIR/trials.csv (world, style, signage, navigator, goal, role, seed, perception, success, reason,
+explanation, distance_m, oracle_m, spl, near_at_m, seen_at_m, sim_s, wall_s, cpu_s), DIR/report.md (success
+rate, SPL, ratio to the oracle and failures by reason: overall, per navigator, style, signage level, goal
+role and world; the ten worst trials with pictures in DIR/worst/) and, for the zoo, the paper's Table I
+extended, DIR/comparison.png (box plots like the paper's Fig. 11) and DIR/paths/GOAL.png. Run again on the
+same DIR to resume (across worlds): finished trials are skipped; other settings on the same DIR are refused.
 """
 
 from __future__ import annotations
@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from abstract_map.cli import ExitError
+from sim.navigation.names import navigator_help
 
 SUMMARY = "run every goal of one or more worlds N times per navigator and report (needs [sim])"
 EXTRA = "sim"  # the optional dependencies it needs
@@ -42,10 +43,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "repeatable (default: zoo)")
     parser.add_argument("--trials", type=int, default=5, help="trials per goal and navigator (default 5)")
     parser.add_argument("--navigator", action="append", metavar="NAME",
-                        help="paper (default; the paper's robot), frontier (reads no sign), viewpoint "
-                             "(negative information), guided (frontiers by the goal belief behind them) and/or "
-                             "known-goal (guided told where the goal's label hangs: an informed reference); "
-                             "repeatable or a comma list, to compare them side by side")
+                        help=f"{navigator_help('paper')}; repeatable or a comma list, to compare them side "
+                             "by side")
     parser.add_argument("--workers", type=int, default=2, help="parallel trials (default 2)")
     parser.add_argument("--perception", default="camera", choices=["camera", "geometric"])
     parser.add_argument("--log", action="store_true",

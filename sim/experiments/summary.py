@@ -180,6 +180,10 @@ def summary_markdown(records: list[Record], *, worst: list[Record], pictures: It
         lines += grouped_table(records, ["navigator", "style"], lambda r: (nav(r), r.get("style") or "-"))
         lines += ["", "### By signage level", ""]
         lines += grouped_table(records, ["navigator", "signage"], lambda r: (nav(r), r.get("signage") or "-"))
+        lines += ["", "### By goal role", "",
+                  "Why the generator chose each goal (world.json's `goal_roles`; `worlds/README.md`, *Goals*): "
+                  "behind a loop, off a dead end, named by no arrow, off a hall, through a room, or far.", ""]
+        lines += grouped_table(records, ["navigator", "role"], lambda r: (nav(r), r.get("role") or "-"))
     lines += ["", "### Failures by reason", ""]
     failures = Counter((nav(r), reason_kind(r), explanation_kind(r)) for r in records if not r["success"])
     if failures:

@@ -28,6 +28,7 @@ from pathlib import Path
 from abstract_map.cli import ExitError, output_folder
 from abstract_map.errors import integer, number, place_name
 from abstract_map.files import json_text, write_text_atomic
+from sim.navigation.names import navigator_help
 
 SUMMARY = "run one closed-loop trial in a pybullet world (needs the [sim] extra)"
 EXTRA = "sim"  # the optional dependencies it needs
@@ -40,13 +41,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--perception", default="camera", choices=["camera", "geometric"],
                         help="rendered camera + OpenCV AprilTag detector, or the fast geometric check")
     parser.add_argument("--navigator", default="paper",
-                        help="navigation policy: paper (the paper's robot, reads signs; default), frontier "
-                             "(nearest frontier, reads no sign: the no-signs lower bound), viewpoint (negative "
-                             "information: to where the goal's label may still be read), guided (the frontier "
-                             "with the best rate of goal belief per metre walked past it, from the arrows, signs, "
-                             "doorways and abstract map; it reads the plates it sees from afar) or known-goal "
-                             "(guided told where the goal's label hangs: an informed reference, not for unseen "
-                             "buildings)")
+                        help=f"navigation policy: {navigator_help('paper')}")
     parser.add_argument("--out", type=Path, required=True, help="output folder")
     parser.add_argument("--record", action="store_true", help="also write DIR/run.gif, an animation of the run")
     parser.add_argument("--log", type=Path, metavar="FILE.rrd",

@@ -63,6 +63,17 @@ def test_phases_of_the_found_walks():
     assert row.phases_new == pytest.approx((25.0, 15.0, 0.0))
 
 
+def test_groups_by_goal_role_even_when_the_base_predates_it():
+    base = [record("A", 0.5), record("B", 0.4), record("C", 0.3)]  # a study run before roles were recorded
+    new = [record("A", 0.6, role="hall"), record("B", 0.2, role="dead end"), record("C", 0.5, role="hall")]
+    rows = {r.group: r for r in compare(base, new, groups=("role",)).rows}
+    assert set(rows) == {"all", "role=hall", "role=dead end"}
+    assert rows["role=hall"].trials == 2 and rows["role=hall"].change == pytest.approx(0.15)
+    assert rows["role=dead end"].change == pytest.approx(-0.2)
+    none = {r.group for r in compare(base, base, groups=("role",)).rows}
+    assert none == {"all", "role=-"}
+
+
 def test_two_navigators_of_one_study(tmp_path):
     folder = study(tmp_path / "dev", [record("A", 0.2, navigator="paper"), record("A", 0.7),
                                       record("B", 0.1, navigator="paper"), record("B", 0.5)])

@@ -43,6 +43,29 @@ def test_study_runs_resumes_and_writes_csv(tiny_world, tmp_path):
     assert stamps == {p.name: p.stat().st_mtime_ns for p in (tmp_path / "trials").iterdir()}
 
 
+def test_a_generated_goal_carries_its_role_into_records_csv_and_resumed_records(tiny_world, tmp_path):
+    import json
+
+    made = tmp_path / "made"
+    shutil.copytree(tiny_world.root, made)
+    meta = json.loads((made / "world.json").read_text())
+    meta["generator"] = {"style": "office", "signage": "complete", "goal_roles": {"A": "dead end"}}
+    (made / "world.json").write_text(json.dumps(meta))
+    specs = plan_specs(load_world(made), 1, "geometric")
+    assert [(s.goal, s.style, s.signage, s.role) for s in specs] == [("A", "office", "complete", "dead end")]
+    assert tiny_specs(tiny_world, 1)[0].role == ""  # a world the generator did not make has no roles
+    out = tmp_path / "study"
+    [first] = run_study(specs, out, executor=ProcessExecutor(1))
+    assert first["role"] == "dead end"
+    assert [r["role"] for r in csv.DictReader((out / "trials.csv").open())] == ["dead end"]
+    [path] = (out / "trials").rglob("*.json")
+    old = json.loads(path.read_text())
+    del old["role"]  # as written before roles were recorded
+    path.write_text(json.dumps(old))
+    [resumed] = run_study(specs, out, executor=ProcessExecutor(1))
+    assert resumed["role"] == "dead end" and resumed["distance_m"] == first["distance_m"]
+
+
 def test_a_failing_trial_is_recorded_and_the_rest_go_on(tiny_world, tmp_path):
     bad = TrialSpec(str(tiny_world.root), "Narnia", 0, "geometric", study_params("geometric"))
     records = run_study([bad, *tiny_specs(tiny_world, 1)], tmp_path, executor=ProcessExecutor(1))
@@ -208,7 +231,8 @@ def test_summary_groups_scores_and_lists_the_worst(tmp_path):
     worst = worst_trials(records, 2)
     assert [r["navigator"] for r in worst] == ["frontier", "paper"] and worst[1]["spl"] == 0.75
     text = summary_markdown(records, worst=worst, pictures=[tmp_path / "w" / "1.png", None], relative_to=tmp_path)
-    assert "### By style" in text and "### By signage level" in text
+    assert "### By style" in text and "### By signage level" in text and "### By goal role" in text
+    assert "| paper | - | 100% (2/2) |" in text  # records without a role are grouped, not dropped
     assert "| frontier | distance cap of N m reached | reads no signs | 1 |" in text
     assert "- *passed edge-on*: within range of the label only beside or behind it" in text  # the legend
     assert "failed: distance cap of 300 m reached; reads no signs: nearest 9.4 m" in text  # the worst trials

@@ -14,6 +14,21 @@ def test_searchers_are_navigators_beside_paper():
     assert {"paper", *SEARCHERS} <= set(NAVIGATORS)
 
 
+def test_the_help_names_every_navigator_in_the_registrys_order():
+    import argparse
+
+    from sim.experiments.study_command import add_arguments
+    from sim.navigation.names import NAVIGATOR_SUMMARIES, navigator_help
+
+    assert list(NAVIGATOR_SUMMARIES) == list(NAVIGATORS)
+    text = navigator_help("paper")
+    assert text.startswith("paper (") and "; default)" in text.split("; frontier")[0]
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    shown = " ".join(parser.format_help().split())
+    assert all(f"{name} (" in shown for name in NAVIGATORS)
+
+
 @pytest.mark.parametrize("navigator", SEARCHERS)
 def test_searcher_finds_the_tiny_goal_and_records_belief_and_swept_space(tiny_world, navigator):
     result = run_trial(tiny_world, "A", seed=1, perception="geometric", navigator=navigator, record=True)
