@@ -22,7 +22,7 @@ generalise  test buildings (seeds 1000-1029, medium, styles and signage levels c
          geometric perception, navigators paper, frontier, guided and known-goal (guided told where the goal's
          label hangs: an informed reference); then 10 of them (1000-1009) with the
          camera and the guided navigator; each trial capped at 600 s simulated. Success, SPL, ratio to oracle
-         and wall time per navigator and signage level, and per style.
+         and wall time per navigator and signage level, per style and per goal role.
          A resumable study folder (--out, default runs/generalise); named only, never part of the default set.
 recording  what a rerun recording (--log) costs: the Kingfisher trial with and without it, per perception mode
            (needs the viz extra)

@@ -128,6 +128,15 @@ def test_report_with_oracle_and_plot(tmp_path):
     assert (tmp_path / "comparison.png").stat().st_size > 10_000
 
 
+def test_study_help_lists_every_csv_column():
+    """The help's list of trials.csv columns is written by hand beside CSV_FIELDS: it names each of them."""
+    import sim.experiments.study_command as command
+    from sim.experiments.study import CSV_FIELDS
+
+    listed = " ".join(command.__doc__.split())
+    assert f"DIR/trials.csv ({', '.join(CSV_FIELDS)})" in listed
+
+
 def test_study_command_end_to_end(tiny_world, tmp_path):
     from abstract_map.cli import main
 
