@@ -29,6 +29,20 @@ def test_the_help_names_every_navigator_in_the_registrys_order():
     assert all(f"{name} (" in shown for name in NAVIGATORS)
 
 
+def test_the_readme_lists_every_navigator_in_the_registrys_order():
+    """The README's study synopsis and its prose about ``--navigator`` are written by hand beside the registry."""
+    import re
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parents[3] / "README.md").read_text()
+    synopsis = re.search(r"abstract-map study [^`]*\[--navigator ([\w,-]+)\]", readme)
+    assert synopsis is not None, "the README's study synopsis lost its [--navigator ...]"
+    assert synopsis.group(1).split(",") == list(NAVIGATORS)
+    prose = readme[readme.index("`--navigator` (repeatable"):]
+    prose = prose[:prose.index("The study writes")]
+    assert [name for name in NAVIGATORS if f"`{name}` " not in prose] == []  # each one described there
+
+
 @pytest.mark.parametrize("navigator", SEARCHERS)
 def test_searcher_finds_the_tiny_goal_and_records_belief_and_swept_space(tiny_world, navigator):
     result = run_trial(tiny_world, "A", seed=1, perception="geometric", navigator=navigator, record=True)
