@@ -2,19 +2,14 @@
 
 from __future__ import annotations
 
-import importlib.util
 import sys
-from pathlib import Path
 
-BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks" / "run.py"
+from tests.repo_files import load_file
 
 
 def _benchmarks(monkeypatch):
-    spec = importlib.util.spec_from_file_location("benchmarks_run", BENCHMARKS)
-    run = importlib.util.module_from_spec(spec)
-    monkeypatch.setitem(sys.modules, "benchmarks_run", run)  # dataclasses look their module up there
-    spec.loader.exec_module(run)
-    return run
+    return load_file("benchmarks/run.py", "benchmarks_run",
+                     lambda name, module: monkeypatch.setitem(sys.modules, name, module))
 
 
 def test_a_shared_run_is_costed_once(monkeypatch):

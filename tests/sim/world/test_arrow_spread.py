@@ -2,22 +2,16 @@
 
 from __future__ import annotations
 
-import importlib.util
 import math
-from pathlib import Path
 
 import pytest
 
 from sim.world.data import Tag, load_world
-
-SCRIPT = Path(__file__).resolve().parents[3] / "scripts" / "arrow_spread.py"
+from tests.repo_files import load_file
 
 
 def load():
-    spec = importlib.util.spec_from_file_location("arrow_spread", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_file("scripts/arrow_spread.py", "arrow_spread")
 
 
 def test_a_label_is_measured_along_and_across_its_arrow():

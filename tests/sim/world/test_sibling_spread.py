@@ -2,17 +2,11 @@
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
-SCRIPT = Path(__file__).resolve().parents[3] / "scripts" / "sibling_spread.py"
+from tests.repo_files import load_file
 
 
 def load():
-    spec = importlib.util.spec_from_file_location("sibling_spread", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_file("scripts/sibling_spread.py", "sibling_spread")
 
 
 def test_sibling_labels_hang_within_the_building_and_apart(capsys):
