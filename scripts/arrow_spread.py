@@ -7,9 +7,9 @@ For every arrow line of every sign and every place it names whose label the worl
 from the sign (m) split along the arrow and across it. Prints, per style (generated) or for the world, the
 median and standard deviation along, the rms and median size across, and the rms miss of a place put
 ``length`` m along the arrow (``--length``, default 8 m: where the spring model's arrow spring holds a place
-at the sign scale of level 1; ``docs/method-notes.md``, "What the imagined goal is worth"). Seed ``s`` is
-style ``STYLES[s % 4]``, medium size, complete signage (every arrow to a goal; the layout does not depend on
-the signage).
+at the sign scale of level 1; ``docs/method-notes.md``, "What the imagined goal is worth"). The seeds are
+``generated:FIRST-LAST:signage=complete`` (style cycling with the seed, medium size; every arrow to a goal,
+and the layout does not depend on the signage).
 """
 
 from __future__ import annotations
@@ -25,9 +25,9 @@ from tqdm import tqdm
 from abstract_map.clauses import Locational
 from abstract_map.errors import AbstractMapError
 from abstract_map.grammar import Anchor, parse_cue
+from sim.experiments.world_spec import parse_world_spec
 from sim.world.data import Tag, World, load_world
 from sim.world.generator import generate
-from sim.world.styles import STYLES
 
 
 def arrow_offsets(tags: Iterable[Tag]) -> list[tuple[float, float]]:
@@ -38,8 +38,10 @@ def arrow_offsets(tags: Iterable[Tag]) -> list[tuple[float, float]]:
     out = []
     for sign in (t for t in tags if t.kind == "sign"):
         for clause in parse_cue(sign.text, Anchor(f"#{sign.id}", sign.x, sign.y, sign.theta), kind="sign"):
-            label = labels.get(clause.toponym.casefold()) if isinstance(clause, Locational) else None
-            if label is None or clause.kind != "arrow":
+            if not isinstance(clause, Locational) or clause.kind != "arrow":
+                continue
+            label = labels.get(clause.toponym.casefold())
+            if label is None:
                 continue
             dx, dy = label.x - sign.x, label.y - sign.y
             c, s = math.cos(clause.direction), math.sin(clause.direction)
@@ -78,11 +80,10 @@ def main(argv: list[str] | None = None) -> int:
     if len(args.seeds) not in (0, 2):
         parser.error("give FIRST LAST, or no seeds")
     first, last = args.seeds if args.seeds else (0, 99)
-    styles = list(STYLES)
     by_style: dict[str, list[tuple[float, float]]] = defaultdict(list)
-    for seed in tqdm(range(first, last + 1), desc="buildings"):
-        style = styles[seed % len(styles)]
-        by_style[style] += world_offsets(generate(seed, style=style).world)
+    for building in tqdm(parse_world_spec(f"generated:{first}-{last}:signage=complete").generated(),
+                         desc="buildings"):
+        by_style[building.style] += world_offsets(generate(building.seed, style=building.style).world)
     print(summary("all", [o for os_ in by_style.values() for o in os_], args.length))
     for style, offsets in sorted(by_style.items()):
         print(summary(style, offsets, args.length))

@@ -14,8 +14,8 @@ from collections import defaultdict
 import numpy as np
 from tqdm import tqdm
 
+from sim.experiments.world_spec import parse_world_spec
 from sim.world.generator import generate
-from sim.world.styles import STYLES
 
 
 def sibling_distances(seed: int, style: str) -> list[float]:
@@ -34,11 +34,10 @@ def sibling_distances(seed: int, style: str) -> list[float]:
 
 def main(argv: list[str]) -> int:
     first, last = (int(argv[0]), int(argv[1])) if len(argv) == 2 else (0, 99)
-    styles = list(STYLES)
     by_style: dict[str, list[float]] = defaultdict(list)
-    for seed in tqdm(range(first, last + 1), desc="buildings"):
-        style = styles[seed % len(styles)]
-        by_style[style] += sibling_distances(seed, style)
+    for building in tqdm(parse_world_spec(f"generated:{first}-{last}:signage=complete").generated(),
+                         desc="buildings"):
+        by_style[building.style] += sibling_distances(building.seed, building.style)
     rows = [("all", [d for ds in by_style.values() for d in ds])] + sorted(by_style.items())
     for name, ds in rows:
         d = np.asarray(ds)
