@@ -58,6 +58,8 @@ class GuideParams:
     look_ahead_m: tuple[float, ...] = (0.0, 3.0, 6.0, 12.0, 24.0, 48.0, 96.0)  # m walked past a frontier over which
     # its worth is the best rate of belief per metre (module docstring): doubling steps from one look (3 m) to
     # about a building's span; empty: a frontier is worth all the mass behind it, however far
+    known_front_m: float = 1.5  # m in front of the goal's label the ``known-pose`` reference drives to: past the
+    # camera's 1 m near limit and well inside the 4 m reading range
     known_spread_m: float = 1.0  # m, the ``known-goal`` baseline's prior about the goal's true label: the label to
     # within the wall and door beside it; 5 m gave the same walks (complete-signage development goals, SPL 0.800
     # against 0.803; docs/method-notes.md, "The ceiling of a known goal")

@@ -15,6 +15,8 @@ NAVIGATOR_SUMMARIES: dict[str, str] = {
               "doorways and abstract map; it reads the plates it sees from afar",
     "known-goal": "guided told where the goal's label hangs: an informed reference, not a navigator for unseen "
                   "buildings",
+    "known-pose": "told where the goal's label hangs and which way it faces, straight there over the map as it "
+                  "grows: the informed point-goal reference, not a navigator for unseen buildings",
 }
 
 

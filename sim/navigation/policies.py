@@ -23,8 +23,12 @@ differs is where it wants to go. Register a new one in :data:`NAVIGATORS`.
   walls seen from afar without a plate and stepping in front of plates seen but
   unread (:mod:`sim.navigation.spotted`).
 - ``known-goal``: ``guided`` with the goal's prior on its true label (the
-  world's truth): the reference of a search that knows where the goal is but
-  not the building (a ceiling in practice), beside ``frontier``'s lower bound.
+  world's truth): what this search walks when it knows where the goal is but
+  not the building, beside ``frontier``'s lower bound.
+- ``known-pose``: told where the goal's label hangs and which way it faces,
+  drives straight to the space in front of it (unseen space as open,
+  re-planned as the map grows): the textbook point-goal planner, the informed
+  reference for what a building not yet mapped costs any navigator.
 """
 
 from __future__ import annotations
@@ -641,12 +645,61 @@ class KnownGoalPolicy(GuidedPolicy):
         return GoalPrior(self.label_xy, self.params.guide.known_spread_m, self.family_labels())
 
 
+class KnownPosePolicy(Driven):
+    """Told where the goal's label hangs and which way it faces: to the space in front of it, the shortest way
+    over the robot's own map (unseen space as open, re-planned as the map grows), then turning to face it.
+
+    The informed reference for what a building not yet mapped costs: the oracle knows the walls, this
+    knows only the goal (``docs/method-notes.md``, "A known goal driven to"). Reads no sign.
+    """
+
+    def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
+        from sim.world.oracle import oracle_path  # the truth: only this baseline may ask it
+
+        self.params = params
+        self.drive = DriveStack(params)
+        self.cues: list[CueEvent] = []  # reads no sign
+        try:
+            tag = world.tags[oracle_path(world, goal, (start[0], start[1])).tag_id]
+        except ValueError:  # a start within the robot's radius of a wall: the world's own start
+            tag = world.tags[oracle_path(world, goal).tag_id]
+        self.label_xy = np.array([tag.x, tag.y], dtype=float)
+        facing = np.array([math.cos(tag.theta), math.sin(tag.theta)])
+        self.target = self.label_xy + params.guide.known_front_m * facing
+        self.arrived = False
+
+    def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
+                grid: OccupancyGrid, spotted: Sequence[Spot] = ()) -> None:
+        """Signs are not read: nothing to take in."""
+
+    def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
+                rng: np.random.Generator) -> tuple[float, float]:
+        if not self.arrived:
+            v, w, self.arrived = self.drive.drive(t_s, pose, grid, self.target, tick_s,
+                                                  self.params.navigator.arrive_m, rng)
+            if not self.arrived:
+                return v, w
+        # In front of the label: turn to face it (the trial ends when it is read).
+        bearing = math.atan2(self.label_xy[1] - pose[1], self.label_xy[0] - pose[0])
+        error = (bearing - pose[2] + math.pi) % (2 * math.pi) - math.pi
+        follower = self.params.follower
+        return 0.0, float(np.clip(follower.turn_gain * error, -follower.max_turn, follower.max_turn))
+
+    def picture(self) -> tuple[dict[str, tuple[float, float]], tuple[float, float], np.ndarray | None]:
+        plan = self.drive.plan
+        return {}, (float(self.target[0]), float(self.target[1])), None if plan is None else plan.waypoints
+
+    def settles(self) -> list[SettleReport]:
+        return []
+
+
 NAVIGATORS: dict[str, type] = {
     "paper": PaperPolicy,
     "frontier": FrontierPolicy,
     "viewpoint": ViewpointPolicy,
     "guided": GuidedPolicy,
     "known-goal": KnownGoalPolicy,
+    "known-pose": KnownPosePolicy,
 }
 """Every navigation policy by its ``--navigator`` name; each is built as ``cls(world, goal, start, params)``."""
 

@@ -194,3 +194,28 @@ def test_known_goal_puts_its_prior_on_the_label_the_oracle_reads(tmp_path):
         assert np.allclose(prior.centre, (tag.x, tag.y))
         assert prior.sigma_m == params.guide.known_spread_m
         assert float(np.hypot(*(policy.nav.model.goal_estimate() - prior.centre))) > 0.5  # not the model's
+
+
+def test_known_pose_drives_to_the_front_of_the_label_the_oracle_reads(tmp_path):
+    """The informed point-goal reference: its target lies ``known_front_m`` in front of the oracle's label, and
+    it reads that label over a generated building it has to map, at most a few metres past the oracle."""
+    import math
+
+    from sim.experiments.study import study_params
+    from sim.experiments.trial import TrialParams, policy_params
+    from sim.navigation.policies import KnownPosePolicy
+    from sim.world.data import load_world
+    from sim.world.generator import generated_world
+    from sim.world.oracle import oracle_path
+
+    world = load_world(generated_world(3, style="office", size="small", signage="complete", root=tmp_path))
+    goal = sorted(world.goals)[0]
+    params = study_params("geometric", TrialParams(max_sim_s=300))
+    policy = KnownPosePolicy(world, goal, world.start, policy_params(params))
+    tag = world.tags[oracle_path(world, goal, world.start[:2]).tag_id]
+    front = params.guide.known_front_m
+    assert policy.target == pytest.approx([tag.x + front * math.cos(tag.theta), tag.y + front * math.sin(tag.theta)])
+    result = run_trial(world, goal, seed=0, perception="geometric", navigator="known-pose", params=params)
+    assert result.success, result.reason
+    assert result.cues == []  # it reads no sign
+    assert result.distance_m < world.oracle_m[goal] * 1.5 + 2.0
