@@ -63,7 +63,7 @@ from sim.navigation.targeting import Target, TargetParams, choose_target
 from sim.navigation.viewpoints import ViewpointParams, Viewpoints, score_viewpoints, travel_costs
 from sim.perception.sighting import Sighting
 from sim.perception.spotting import Spot
-from sim.world.data import World
+from sim.world.data import Tag, World
 
 Pose = tuple[float, float, float]
 
@@ -619,6 +619,17 @@ class GuidedPolicy(AbstractMapPolicy):
         return covered | seen.swept if seen is not None and seen.swept.shape == covered.shape else covered
 
 
+def oracle_label(world: World, goal: str, start: Pose) -> Tag:
+    """The goal's label the oracle reads first from ``start`` (the world's truth: only the informed references
+    may ask it); from the world's own start when ``start`` lies within the robot's radius of a wall."""
+    from sim.world.oracle import oracle_path
+
+    try:
+        return world.tags[oracle_path(world, goal, (start[0], start[1])).tag_id]
+    except ValueError:
+        return world.tags[oracle_path(world, goal).tag_id]
+
+
 class KnownGoalPolicy(GuidedPolicy):
     """``guided`` told where the goal's label hangs: an informed reference, not a navigator for unseen buildings.
 
@@ -633,12 +644,7 @@ class KnownGoalPolicy(GuidedPolicy):
 
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
         super().__init__(world, goal, start, params)
-        from sim.world.oracle import oracle_path  # the truth: only this baseline may ask it
-
-        try:
-            tag = world.tags[oracle_path(world, goal, (start[0], start[1])).tag_id]
-        except ValueError:  # a start within the robot's radius of a wall: the world's own start
-            tag = world.tags[oracle_path(world, goal).tag_id]
+        tag = oracle_label(world, goal, start)
         self.label_xy = np.array([tag.x, tag.y], dtype=float)
 
     def goal_prior(self) -> GoalPrior:
@@ -654,15 +660,10 @@ class KnownPosePolicy(Driven):
     """
 
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
-        from sim.world.oracle import oracle_path  # the truth: only this baseline may ask it
-
         self.params = params
         self.drive = DriveStack(params)
         self.cues: list[CueEvent] = []  # reads no sign
-        try:
-            tag = world.tags[oracle_path(world, goal, (start[0], start[1])).tag_id]
-        except ValueError:  # a start within the robot's radius of a wall: the world's own start
-            tag = world.tags[oracle_path(world, goal).tag_id]
+        tag = oracle_label(world, goal, start)
         self.label_xy = np.array([tag.x, tag.y], dtype=float)
         facing = np.array([math.cos(tag.theta), math.sin(tag.theta)])
         self.target = self.label_xy + params.guide.known_front_m * facing
