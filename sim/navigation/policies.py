@@ -44,7 +44,15 @@ from abstract_map.clauses import Locational
 from abstract_map.model import SettleReport, imagined_positions
 from sim.mapping.occupancy import OccupancyGrid
 from sim.navigation.belief import Belief, BeliefParams, GoalPrior, SweptSpace, cue_mass, goal_belief, goal_sigma
-from sim.navigation.follower import FollowerParams, PathFollower, Recovery, RecoveryParams, StuckDetector, StuckParams
+from sim.navigation.follower import (
+    FollowerParams,
+    PathFollower,
+    Recovery,
+    RecoveryParams,
+    StuckDetector,
+    StuckParams,
+    wrap_angle,
+)
 from sim.navigation.frontier import FrontierParams, LookedAt, nearest_frontier, still_frontier
 from sim.navigation.gateways import GuideParams, frontier_values
 from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
@@ -384,7 +392,23 @@ class FrontierSearch:
         return (math.nan, math.nan) if self.target is None else (float(self.target[0]), float(self.target[1]))
 
 
-class FrontierPolicy(Driven):
+class SignBlind(Driven):
+    """A driven policy that reads no sign: nothing to take in, no model to settle."""
+
+    def __init__(self, params: PolicyParams) -> None:
+        self.params = params
+        self.drive = DriveStack(params)
+        self.cues: list[CueEvent] = []  # reads no sign
+
+    def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
+                grid: OccupancyGrid, spotted: Sequence[Spot] = ()) -> None:
+        """Signs are not read: nothing to take in."""
+
+    def settles(self) -> list[SettleReport]:
+        return []
+
+
+class FrontierPolicy(SignBlind):
     """Explore without reading signs: the nearest reachable frontier, until the goal's label is read.
 
     The trial judges success from the goal's label, so this policy ignores every
@@ -395,14 +419,8 @@ class FrontierPolicy(Driven):
 
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams,
                  frontier: FrontierParams | None = None) -> None:
-        self.params = params
-        self.drive = DriveStack(params)
+        super().__init__(params)
         self.search = FrontierSearch(params, self.drive, frontier or FrontierParams())
-        self.cues: list[CueEvent] = []  # reads no sign
-
-    def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
-                grid: OccupancyGrid, spotted: Sequence[Spot] = ()) -> None:
-        """Signs are not read: nothing to take in."""
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:
@@ -414,9 +432,6 @@ class FrontierPolicy(Driven):
     def picture(self) -> tuple[dict[str, tuple[float, float]], tuple[float, float], np.ndarray | None]:
         plan = self.drive.plan
         return {}, self.search.shown(), None if plan is None else plan.waypoints
-
-    def settles(self) -> list[SettleReport]:
-        return []
 
 
 class ViewpointPolicy(AbstractMapPolicy):
@@ -651,7 +666,7 @@ class KnownGoalPolicy(GuidedPolicy):
         return GoalPrior(self.label_xy, self.params.guide.known_spread_m, self.family_labels())
 
 
-class KnownPosePolicy(Driven):
+class KnownPosePolicy(SignBlind):
     """Told where the goal's label hangs and which way it faces: to the space in front of it, the shortest way
     over the robot's own map (unseen space as open, re-planned as the map grows), then turning to face it.
 
@@ -660,18 +675,12 @@ class KnownPosePolicy(Driven):
     """
 
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
-        self.params = params
-        self.drive = DriveStack(params)
-        self.cues: list[CueEvent] = []  # reads no sign
+        super().__init__(params)
         tag = oracle_label(world, goal, start)
         self.label_xy = np.array([tag.x, tag.y], dtype=float)
         facing = np.array([math.cos(tag.theta), math.sin(tag.theta)])
         self.target = self.label_xy + params.guide.known_front_m * facing
         self.arrived = False
-
-    def observe(self, sightings: Iterable[Sighting], *, t_s: float, distance_m: float,
-                grid: OccupancyGrid, spotted: Sequence[Spot] = ()) -> None:
-        """Signs are not read: nothing to take in."""
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:
@@ -682,16 +691,13 @@ class KnownPosePolicy(Driven):
                 return v, w
         # In front of the label: turn to face it (the trial ends when it is read).
         bearing = math.atan2(self.label_xy[1] - pose[1], self.label_xy[0] - pose[0])
-        error = (bearing - pose[2] + math.pi) % (2 * math.pi) - math.pi
+        error = wrap_angle(bearing - pose[2])
         follower = self.params.follower
         return 0.0, float(np.clip(follower.turn_gain * error, -follower.max_turn, follower.max_turn))
 
     def picture(self) -> tuple[dict[str, tuple[float, float]], tuple[float, float], np.ndarray | None]:
         plan = self.drive.plan
         return {}, (float(self.target[0]), float(self.target[1])), None if plan is None else plan.waypoints
-
-    def settles(self) -> list[SettleReport]:
-        return []
 
 
 NAVIGATORS: dict[str, type] = {
