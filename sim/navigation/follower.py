@@ -49,6 +49,11 @@ class FollowerParams:
             if value is not None and not (math.isfinite(value) and value > 0):
                 raise ValueError(f"FollowerParams.{name} must be None or finite and > 0, got {value}")
 
+    def turn_in_place(self, error_rad: float) -> float:
+        """The turn rate (rad/s) that turns in place against a heading error (rad): ``turn_gain`` times it,
+        capped at ``max_turn``."""
+        return float(np.clip(self.turn_gain * error_rad, -self.max_turn, self.max_turn))
+
 
 def _check_waypoints(waypoints: np.ndarray) -> np.ndarray:
     pts = np.asarray(waypoints, dtype=float)
@@ -116,7 +121,7 @@ class PathFollower:
             offset, distance = pts[-1] - position, to_goal
         alpha = wrap_angle(math.atan2(offset[1], offset[0]) - theta)
 
-        turn_in_place = float(np.clip(p.turn_gain * alpha, -p.max_turn, p.max_turn))
+        turn_in_place = p.turn_in_place(alpha)
         if abs(alpha) >= p.turn_in_place_rad:
             v, w = 0.0, turn_in_place
         else:

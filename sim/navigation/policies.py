@@ -691,9 +691,7 @@ class KnownPosePolicy(SignBlind):
                 return v, w
         # In front of the label: turn to face it (the trial ends when it is read).
         bearing = math.atan2(self.label_xy[1] - pose[1], self.label_xy[0] - pose[0])
-        error = wrap_angle(bearing - pose[2])
-        follower = self.params.follower
-        return 0.0, float(np.clip(follower.turn_gain * error, -follower.max_turn, follower.max_turn))
+        return 0.0, self.params.follower.turn_in_place(wrap_angle(bearing - pose[2]))
 
     def picture(self) -> tuple[dict[str, tuple[float, float]], tuple[float, float], np.ndarray | None]:
         plan = self.drive.plan
