@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -98,13 +99,22 @@ class PathFollower:
         self._last = (0.0, 0.0)
 
     def command(self, pose: tuple[float, float, float] | np.ndarray, waypoints: np.ndarray,
-                dt_s: float | None = None) -> tuple[float, float, bool]:
+                dt_s: float | None = None, clear: Callable[[float, float], bool] | None = None,
+                nearer_m: Sequence[float] = (), creep_mps: float = 0.0) -> tuple[float, float, bool]:
         """(v m/s, w rad/s, done) to follow ``waypoints`` (N, 2, m) from ``pose`` (x m, y m, theta rad).
 
         ``done`` is True, with a zero command, once the robot is within
         ``goal_tolerance_m`` of the last waypoint. ``dt_s`` (s since the
         last command) enables the acceleration limits when they are set;
         the stop on arrival is not rate-limited (the approach is already slow).
+
+        ``clear(v, w)`` says whether a command may be driven (the caller's
+        map: :func:`sim.navigation.footprint.blocked`). When the command for
+        the carrot ``lookahead_m`` on is not, the first clear one of these is
+        taken: the commands for the carrots ``nearer_m`` (m, in turn), then
+        ``creep_mps`` straight ahead, then as fast straight back (when
+        ``creep_mps`` > 0). When none is clear the first command stands (the
+        stuck recovery then backs the robot off).
         """
         p = self.params
         x, y, theta = check_pose(pose)
@@ -114,8 +124,19 @@ class PathFollower:
         if to_goal <= p.goal_tolerance_m:
             self._last = (0.0, 0.0)
             return 0.0, 0.0, True
+        v, w = self._steer(position, theta, pts, to_goal, p.lookahead_m)
+        if clear is not None and not clear(v, w):
+            creeps = [(creep_mps, 0.0), (-creep_mps, 0.0)] if creep_mps > 0 else []
+            others = (self._steer(position, theta, pts, to_goal, lookahead) for lookahead in nearer_m)
+            v, w = next((c for c in (*others, *creeps) if clear(*c)), (v, w))
+        v, w = self._limit(v, w, dt_s)
+        return v, w, False
 
-        offset = carrot(position, pts, p.lookahead_m) - position
+    def _steer(self, position: np.ndarray, theta: float, pts: np.ndarray, to_goal: float,
+               lookahead_m: float) -> tuple[float, float]:
+        """(v m/s, w rad/s) towards the carrot ``lookahead_m`` (m) along ``pts`` from ``position``, before limits."""
+        p = self.params
+        offset = carrot(position, pts, lookahead_m) - position
         distance = float(np.hypot(*offset))
         if distance < 1e-9:  # on the carrot: aim at the goal instead
             offset, distance = pts[-1] - position, to_goal
@@ -123,20 +144,18 @@ class PathFollower:
 
         turn_in_place = p.turn_in_place(alpha)
         if abs(alpha) >= p.turn_in_place_rad:
-            v, w = 0.0, turn_in_place
-        else:
-            # alignment: 1 when facing the carrot, 0 at the turn-in-place threshold. Speed fades with it
-            # (and near the goal) while the turn blends from pure pursuit into turning in place.
-            alignment = (math.cos(alpha) - math.cos(p.turn_in_place_rad)) / (1.0 - math.cos(p.turn_in_place_rad))
-            approach = max(p.min_speed, p.max_speed * min(1.0, to_goal / p.slowdown_m))
-            v = min(p.max_speed, approach) * alignment
-            pursuit = v * 2.0 * math.sin(alpha) / distance
-            w = alignment * pursuit + (1.0 - alignment) * turn_in_place
-            if abs(w) > p.max_turn:  # keep the curvature, slow down instead
-                v *= p.max_turn / abs(w)
-                w = math.copysign(p.max_turn, w)
-        v, w = self._limit(v, w, dt_s)
-        return v, w, False
+            return 0.0, turn_in_place
+        # alignment: 1 when facing the carrot, 0 at the turn-in-place threshold. Speed fades with it
+        # (and near the goal) while the turn blends from pure pursuit into turning in place.
+        alignment = (math.cos(alpha) - math.cos(p.turn_in_place_rad)) / (1.0 - math.cos(p.turn_in_place_rad))
+        approach = max(p.min_speed, p.max_speed * min(1.0, to_goal / p.slowdown_m))
+        v = min(p.max_speed, approach) * alignment
+        pursuit = v * 2.0 * math.sin(alpha) / distance
+        w = alignment * pursuit + (1.0 - alignment) * turn_in_place
+        if abs(w) > p.max_turn:  # keep the curvature, slow down instead
+            v *= p.max_turn / abs(w)
+            w = math.copysign(p.max_turn, w)
+        return v, w
 
     def _limit(self, v: float, w: float, dt_s: float | None) -> tuple[float, float]:
         p = self.params

@@ -53,6 +53,7 @@ from sim.navigation.follower import (
     StuckParams,
     wrap_angle,
 )
+from sim.navigation.footprint import FootprintParams, blocked, body_points
 from sim.navigation.frontier import FrontierParams, LookedAt, nearest_frontier, still_frontier
 from sim.navigation.gateways import GuideParams, frontier_values
 from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
@@ -91,6 +92,7 @@ class PolicyParams:
     routes: RouteParams = field(default_factory=RouteParams)
     guide: GuideParams = field(default_factory=GuideParams)
     spotted: SpottedParams = field(default_factory=SpottedParams)
+    footprint: FootprintParams = field(default_factory=FootprintParams)
 
 
 class Policy(Protocol):
@@ -117,6 +119,9 @@ class Policy(Protocol):
 class DriveStack:
     """Re-planning, path following and stuck recovery towards a target: the part every policy shares.
 
+    A command that would put the body on a mapped wall is not driven: the follower steers at a nearer
+    carrot, or creeps ahead or back, instead (:mod:`sim.navigation.footprint`).
+
     :attr:`wedged` says why driving is hopeless (empty while it is not): ``RecoveryParams.max_in_place``
     recoveries in a row left the robot where the first began."""
 
@@ -124,6 +129,8 @@ class DriveStack:
         self.replanner = Replanner(params.replan, params.planner)
         self.follower = PathFollower(params.follower)
         self.stuck, self.recovery = StuckDetector(StuckParams()), Recovery(RecoveryParams())
+        self.footprint = params.footprint
+        self.body = body_points(params.footprint)  # the body's sample points, robot frame
         self.in_place = 0  # recoveries in a row within ``escape_m`` of where the run began
         self.run_from: np.ndarray | None = None  # m, where the robot stood when the run's first recovery began
         self.wedged = ""
@@ -145,7 +152,9 @@ class DriveStack:
         plan = self.replanner.update(t_s, grid, pose[:2], target_xy)
         if plan is None:
             return 0.0, 0.0, True
-        v, w, done = self.follower.command(pose, plan.waypoints, tick_s)
+        v, w, done = self.follower.command(
+            pose, plan.waypoints, tick_s, clear=lambda v, w: not blocked(grid, pose, v, w, self.footprint, self.body),
+            nearer_m=self.footprint.lookaheads_m, creep_mps=self.footprint.creep_mps)
         arrived = done and float(np.hypot(*(np.array(plan.goal_xy) - pose[:2]))) < arrive_m
         if self.stuck.update(t_s, pose, commanded=abs(v) > 0.01 or abs(w) > 0.01):
             self._count_recovery(np.asarray(pose[:2], dtype=float))

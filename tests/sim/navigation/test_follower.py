@@ -178,3 +178,20 @@ def test_a_wedged_robot_ends_the_policy() -> None:
     assert policy.gave_up.startswith("wedged at")
     policy.gave_up = "no frontier left"  # the policy's own reason comes first
     assert policy.gave_up == "no frontier left"
+
+
+def test_a_command_that_is_not_clear_gives_way_to_nearer_carrots_then_a_creep() -> None:
+    path = np.array([[0.0, 0.0], [0.0, 2.0], [-2.0, 2.0]])  # the carrot 0.8 m on lies round the corner
+    pose = (0.0, 1.5, math.pi / 2)
+    follower = PathFollower()
+    own = follower.command(pose, path, DT)
+    assert own[0] > 0 and own[1] > 0  # on and left, cutting the corner
+    nearer = follower.command(pose, path, DT, clear=lambda v, w: w < own[1], nearer_m=(0.4, 0.2))
+    assert 0 <= nearer[1] < own[1]  # a carrot nearer the corner turns less
+    creeps = []
+    follower.command(pose, path, DT, clear=lambda v, w: creeps.append((v, w)) or v < 0, nearer_m=(0.4, 0.2),
+                     creep_mps=0.1)
+    assert creeps[-2:] == [(0.1, 0.0), (-0.1, 0.0)]  # both carrots refused, then ahead, then back
+    assert follower.command(pose, path, DT, clear=lambda v, w: v < 0, nearer_m=(0.4,), creep_mps=0.1)[:2] == \
+        (-0.1, 0.0)
+    assert follower.command(pose, path, DT, clear=lambda v, w: False, nearer_m=(0.4,), creep_mps=0.1) == own
