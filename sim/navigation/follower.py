@@ -109,7 +109,7 @@ class PathFollower:
         the stop on arrival is not rate-limited (the approach is already slow).
 
         ``clear(v, w)`` says whether a command may be driven (the caller's
-        map: :func:`sim.navigation.footprint.blocked`). When the command for
+        map: :func:`sim.navigation.footprint.clear_of_walls`). When the command for
         the carrot ``lookahead_m`` on is not, the first clear one of these is
         taken: the commands for the carrots ``nearer_m`` (m, in turn), then
         ``creep_mps`` straight ahead, then as fast straight back (when

@@ -27,6 +27,7 @@ counter-clockwise from +x.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -107,14 +108,23 @@ def wall_counts(grid: OccupancyGrid, poses: np.ndarray, body: np.ndarray) -> np.
     return on_wall.reshape(len(poses), -1).sum(axis=1)
 
 
-def blocked(grid: OccupancyGrid, pose: tuple[float, float, float], v: float, w: float,
-            params: FootprintParams = FootprintParams(), body: np.ndarray | None = None) -> bool:
-    """Whether the command (``v`` m/s, ``w`` rad/s) from ``pose`` would put more of the body on mapped wall than
-    lies there now, anywhere it sweeps (:func:`swept_poses`): a body already touching a wall may still move off
-    or along it. Standing still is never blocked. ``body``: :func:`body_points`, when at hand."""
-    ahead = swept_poses(pose, v, w, params)
-    if len(ahead) == 0:
-        return False
+def clear_of_walls(grid: OccupancyGrid, pose: tuple[float, float, float], params: FootprintParams = FootprintParams(),
+                   body: np.ndarray | None = None) -> Callable[[float, float], bool]:
+    """The question ``clear(v, w)`` for commands from ``pose``: whether the command (``v`` m/s, ``w`` rad/s) puts no
+    more of the body on mapped wall than lies there now, anywhere it sweeps (:func:`swept_poses`). A body already
+    touching a wall may still move off or along it; standing still is always clear. The body's count at ``pose``
+    is worked out once, however many commands are asked about. ``body``: :func:`body_points`, when at hand."""
     body = body_points(params) if body is None else body
     now = wall_counts(grid, np.asarray(pose, dtype=float), body)[0]
-    return bool(np.any(wall_counts(grid, ahead, body) > now))
+
+    def clear(v: float, w: float) -> bool:
+        ahead = swept_poses(pose, v, w, params)
+        return len(ahead) == 0 or not bool(np.any(wall_counts(grid, ahead, body) > now))
+
+    return clear
+
+
+def blocked(grid: OccupancyGrid, pose: tuple[float, float, float], v: float, w: float,
+            params: FootprintParams = FootprintParams(), body: np.ndarray | None = None) -> bool:
+    """Whether the command (``v`` m/s, ``w`` rad/s) from ``pose`` is not :func:`clear_of_walls`."""
+    return not clear_of_walls(grid, pose, params, body)(v, w)

@@ -53,7 +53,7 @@ from sim.navigation.follower import (
     StuckParams,
     wrap_angle,
 )
-from sim.navigation.footprint import FootprintParams, blocked, body_points
+from sim.navigation.footprint import FootprintParams, body_points, clear_of_walls
 from sim.navigation.frontier import FrontierParams, LookedAt, nearest_frontier, still_frontier
 from sim.navigation.gateways import GuideParams, frontier_values
 from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
@@ -153,7 +153,7 @@ class DriveStack:
         if plan is None:
             return 0.0, 0.0, True
         v, w, done = self.follower.command(
-            pose, plan.waypoints, tick_s, clear=lambda v, w: not blocked(grid, pose, v, w, self.footprint, self.body),
+            pose, plan.waypoints, tick_s, clear=clear_of_walls(grid, pose, self.footprint, self.body),
             nearer_m=self.footprint.lookaheads_m, creep_mps=self.footprint.creep_mps)
         arrived = done and float(np.hypot(*(np.array(plan.goal_xy) - pose[:2]))) < arrive_m
         if self.stuck.update(t_s, pose, commanded=abs(v) > 0.01 or abs(w) > 0.01):

@@ -9,7 +9,7 @@ import pytest
 
 from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
 from sim.navigation.follower import FollowerParams, PathFollower
-from sim.navigation.footprint import FootprintParams, blocked, body_points, swept_poses, wall_counts
+from sim.navigation.footprint import FootprintParams, blocked, body_points, clear_of_walls, swept_poses, wall_counts
 from sim.world.robot import RobotParams
 
 DT = 0.1  # s, the trials' control tick
@@ -95,8 +95,8 @@ def drive_through(grid: OccupancyGrid, start: tuple[float, float, float], path: 
     refused, poses = 0, [start]
     for _ in range(steps):
         pose = (x, y, theta)
-        clear = (lambda v, w, pose=pose: not blocked(grid, pose, v, w, params, body)) if check else None
-        v, w, done = follower.command((x, y, theta), np.array(path), DT, clear=clear, nearer_m=params.lookaheads_m,
+        clear = clear_of_walls(grid, pose, params, body) if check else None
+        v, w, done = follower.command(pose, np.array(path), DT, clear=clear, nearer_m=params.lookaheads_m,
                                       creep_mps=params.creep_mps)
         if done:
             return True, refused, poses
