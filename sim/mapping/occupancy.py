@@ -192,6 +192,15 @@ class OccupancyGrid:
         """Bool (rows, cols): cells believed occupied."""
         return self.log_odds > self.params.occupied_threshold
 
+    def occupied_cells(self, rc: np.ndarray) -> np.ndarray:
+        """Bool (N,): whether each cell (row, col) of ``rc`` (N, 2) is believed occupied; cells off the grid are not
+        (what :meth:`occupied_mask` says of a few cells, without working it out for the whole grid)."""
+        rc = np.atleast_2d(np.asarray(rc))
+        inside = self.in_bounds(rc)
+        out = np.zeros(len(rc), dtype=bool)
+        out[inside] = self.log_odds[rc[inside, 0], rc[inside, 1]] > self.params.occupied_threshold
+        return out
+
     def free_mask(self) -> np.ndarray:
         """Bool (rows, cols): cells believed free."""
         return self.log_odds < self.params.free_threshold

@@ -101,10 +101,7 @@ def wall_counts(grid: OccupancyGrid, poses: np.ndarray, body: np.ndarray) -> np.
     cos, sin = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
     wx = poses[:, 0:1] + cos * body[None, :, 0] - sin * body[None, :, 1]
     wy = poses[:, 1:2] + sin * body[None, :, 0] + cos * body[None, :, 1]
-    rc = grid.world_to_cell(np.column_stack([wx.ravel(), wy.ravel()]))
-    inside = grid.in_bounds(rc)
-    on_wall = np.zeros(len(rc), dtype=bool)
-    on_wall[inside] = grid.log_odds[rc[inside, 0], rc[inside, 1]] > grid.params.occupied_threshold
+    on_wall = grid.occupied_cells(grid.world_to_cell(np.column_stack([wx.ravel(), wy.ravel()])))
     return on_wall.reshape(len(poses), -1).sum(axis=1)
 
 

@@ -45,15 +45,13 @@ def path_blocked(
     reach = int(math.ceil(reach_m / grid.resolution))
     dr, dc = np.mgrid[-reach:reach + 1, -reach:reach + 1]
     disk = np.hypot(dr, dc) * grid.resolution < reach_m
-    rows, cols = grid.shape
+    cols = grid.shape[1]
     rc = grid.world_to_cell(samples)
     rc = rc[grid.in_bounds(rc)]
     centres = np.unique(rc[:, 0] * cols + rc[:, 1])
     probe_r = centres[:, None] // cols + dr[disk][None, :]
     probe_c = centres[:, None] % cols + dc[disk][None, :]
-    inside = (probe_r >= 0) & (probe_r < rows) & (probe_c >= 0) & (probe_c < cols)
-    values = grid.log_odds[probe_r[inside], probe_c[inside]]
-    return bool(np.any(values > grid.params.occupied_threshold))
+    return bool(grid.occupied_cells(np.column_stack([probe_r.ravel(), probe_c.ravel()])).any())
 
 
 def _densify(points: np.ndarray, step: float) -> np.ndarray:

@@ -127,3 +127,12 @@ def test_bad_inputs_are_named() -> None:
         grid.integrate((0.0, 0.0, 0.0), np.zeros(2), np.ones(1), 8.0)
     with pytest.raises(ValueError, match="bounds"):
         OccupancyParams(bounds=(1.0, 0.0, 0.0, 1.0))
+
+
+def test_occupied_cells_reads_the_mask_at_cells_and_off_the_grid_says_no() -> None:
+    grid = OccupancyGrid(OccupancyParams(bounds=(0.0, 1.0, 0.0, 1.0)))
+    grid.log_odds[3, 4] = grid.params.clamp[1]
+    rc = np.array([[3, 4], [3, 5], [-1, 4], [3, grid.shape[1]]])
+    np.testing.assert_array_equal(grid.occupied_cells(rc), [True, False, False, False])
+    every = np.argwhere(np.ones(grid.shape, dtype=bool))
+    np.testing.assert_array_equal(grid.occupied_cells(every).reshape(grid.shape), grid.occupied_mask())
