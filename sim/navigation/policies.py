@@ -204,6 +204,7 @@ class AbstractMapPolicy(Driven):
         self.start = np.asarray(start, dtype=float)
         self.depth = np.ones(1)  # door-depth weight per grid cell (sim.navigation.routes), set with the belief
         self.evidence: np.ndarray | None = None  # depth x route likelihood, per grid cell
+        self.factors: dict[str, np.ndarray] = {}  # the evidence's factors by name (EVIDENCE_FACTORS), per grid cell
         self.evidence_key: tuple = ()  # the arrows and unnamed signs the evidence was worked out from
         self.evidence_at = -float("inf")
         self.evidence_count = 0  # refreshes of the evidence so far (what was worked out from it knows its age)
@@ -301,11 +302,13 @@ class AbstractMapPolicy(Driven):
                 self.params.routes.evidence_every_s:
             rp = self.params.routes
             self.depth = door_depth_weight(grid, self.start[:2], rp, self.searches)
+            found = {"doors": self.depth, "arrows": route_likelihood(grid, arrows, rp, self.searches),
+                     "unnamed signs": passed_likelihood(grid, unnamed, self.start[:2], rp, self.searches)}
+            self.factors = {name: factor for name, factor in found.items() if factor is not None}
             self.evidence = self.depth
-            for likelihood in (route_likelihood(grid, arrows, rp, self.searches),
-                               passed_likelihood(grid, unnamed, self.start[:2], rp, self.searches)):
-                if likelihood is not None:
-                    self.evidence = self.evidence * likelihood
+            for name in ("arrows", "unnamed signs"):
+                if name in self.factors:
+                    self.evidence = self.evidence * self.factors[name]
             self.evidence_key, self.evidence_at = key, self.now
             self.evidence_count += 1
         return self.evidence
