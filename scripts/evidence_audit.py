@@ -22,8 +22,9 @@ import numpy as np
 from tqdm import tqdm
 
 from abstract_map.errors import AbstractMapError
-from sim.experiments.evidence_audit import FACTORS, AuditRecord, Variant, audit_trial
+from sim.experiments.evidence_audit import AuditRecord, Variant, audit_trial
 from sim.experiments.world_spec import parse_world_spec, resolve_worlds, seed_split
+from sim.navigation.policies import EVIDENCE_FACTORS
 from sim.navigation.routes import RouteParams
 from sim.world.data import load_world
 
@@ -33,9 +34,9 @@ def parse_variant(text: str) -> Variant:
     factor, colon, rest = text.partition(":")
     factor = factor.strip()
     fields = set(RouteParams.__dataclass_fields__)
-    if not colon or factor not in FACTORS:
+    if not colon or factor not in EVIDENCE_FACTORS:
         raise ValueError(f"--variant {text!r}: expected 'FACTOR: FIELD=VALUE, ...' with FACTOR one of "
-                         f"{sorted(FACTORS)}")
+                         f"{list(EVIDENCE_FACTORS)}")
     changes = {}
     for item in filter(None, (p.strip() for p in rest.split(","))):
         key, eq, value = item.partition("=")
@@ -103,12 +104,12 @@ def main(argv: list[str] | None = None) -> int:
                   if seed_split(g.seed) == "test"]
         if tested:
             raise ValueError(f"--world: seeds {tested[:3]}... are test seeds (reporting only); audit development seeds")
-        worlds = [(folder, list(load_world(folder).goals)) for folder in resolve_worlds(specs, args.root)]
+        worlds = [load_world(folder) for folder in resolve_worlds(specs, args.root)]
         done = read_records(args.out)
     except (ValueError, AbstractMapError) as exc:
         print(f"evidence_audit: {exc}", file=sys.stderr)
         return 2
-    jobs = [(str(folder), goal) for folder, goals in worlds for goal in goals[:args.goals]]
+    jobs = [(str(world.root), goal) for world in worlds for goal in list(world.goals)[:args.goals]]
     records = []
     for folder, goal in tqdm(jobs, desc="audit", unit="trial", file=sys.stderr):
         key = (folder, goal, args.seed)
@@ -118,8 +119,7 @@ def main(argv: list[str] | None = None) -> int:
                 with args.out.open("a") as fh:
                     fh.write(json.dumps(done[key].__dict__) + "\n")
         records.append(done[key])
-    signage = {str(folder): json.loads((Path(folder) / "world.json").read_text()).get("generator", {}).get(
-        "signage", "hand-made") for folder, _ in worlds}
+    signage = {str(world.root): str((world.generator or {}).get("signage", "hand-made")) for world in worlds}
     summary(records, signage)
     return 0
 

@@ -26,14 +26,15 @@ so variants can be compared on one run, without a study per setting.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
 from sim.mapping.occupancy import OccupancyGrid
-from sim.navigation.routes import PathSearches, RouteParams, door_depth_weight, passed_likelihood, route_likelihood
+from sim.navigation.policies import EVIDENCE_FACTORS
+from sim.navigation.routes import PathSearches
 
 
 def gain(belief: np.ndarray, factor: np.ndarray, truth: np.ndarray, variant: np.ndarray | None = None) -> float:
@@ -58,21 +59,11 @@ def truth_cells(grid: OccupancyGrid, labels_xy: np.ndarray, goal_m: float) -> np
     return out
 
 
-FactorMaker = Callable[[object, OccupancyGrid, RouteParams, PathSearches], "np.ndarray | None"]
-
-FACTORS: dict[str, FactorMaker] = {  # how a guided policy's evidence factor is made, by its name there
-    "doors": lambda policy, grid, rp, searches: door_depth_weight(grid, policy.start[:2], rp, searches),
-    "arrows": lambda policy, grid, rp, searches: route_likelihood(grid, policy.arrows(), rp, searches),
-    "unnamed signs": lambda policy, grid, rp, searches: passed_likelihood(grid, policy.unnamed(), policy.start[:2],
-                                                                          rp, searches),
-}
-
-
 @dataclass(frozen=True)
 class Variant:
     """A factor made again with other route parameters, judged beside the navigator's own."""
 
-    factor: str  # a key of FACTORS
+    factor: str  # one of sim.navigation.policies.EVIDENCE_FACTORS
     changes: Mapping[str, float]  # RouteParams fields and their values
 
     @property
@@ -119,14 +110,13 @@ def audit_trial(world: str | Path, goal: str, *, seed: int = 0, perception: str 
     from sim.experiments.trial import Trial
 
     for v in variants:
-        if v.factor not in FACTORS:
-            raise ValueError(f"variant {v.name!r}: unknown factor {v.factor!r}; known: {sorted(FACTORS)}")
+        if v.factor not in EVIDENCE_FACTORS:
+            raise ValueError(f"variant {v.name!r}: unknown factor {v.factor!r}; known: {list(EVIDENCE_FACTORS)}")
     record = AuditRecord(str(world), goal, seed)
     with Trial(world, goal, seed=seed, perception=perception, navigator="guided",
                params=replace(study_params(perception), max_sim_s=max_sim_s)) as trial:
         policy = trial.policy
-        labels = np.array([[t.x, t.y] for t in trial.world.tags.values()
-                           if t.kind == "label" and t.text.casefold() == goal.casefold()])
+        labels = np.array([[trial.world.tags[i].x, trial.world.tags[i].y] for i in trial.goal_tags])  # read: found
         searches = PathSearches()
         made: dict[str, np.ndarray] = {}
         made_at, sampled_at = -1, -math.inf
@@ -137,7 +127,7 @@ def audit_trial(world: str | Path, goal: str, *, seed: int = 0, perception: str 
                 made = {}
                 for v in variants:
                     rp = replace(policy.params.routes, **v.changes)
-                    factor = FACTORS[v.factor](policy, trial.grid, rp, searches)
+                    factor = policy.evidence_factors(trial.grid, rp, searches, (v.factor,)).get(v.factor)
                     if factor is not None:
                         made[v.name] = factor
             belief = policy.belief

@@ -33,6 +33,7 @@ differs is where it wants to go. Register a new one in :data:`NAVIGATORS`.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field, replace
@@ -75,6 +76,9 @@ from sim.perception.spotting import Spot
 from sim.world.data import Tag, World
 
 Pose = tuple[float, float, float]
+
+EVIDENCE_FACTORS = ("doors", "arrows", "unnamed signs")  # the goal evidence's factors, in the order they
+# multiply (AbstractMapPolicy.evidence_factors)
 
 
 @dataclass(frozen=True)
@@ -292,6 +296,18 @@ class AbstractMapPolicy(Driven):
                 out.append((sign.x + stand * math.cos(sign.theta), sign.y + stand * math.sin(sign.theta)))
         return out
 
+    def evidence_factors(self, grid: OccupancyGrid, routes: RouteParams, searches: PathSearches,
+                         names: Iterable[str] = EVIDENCE_FACTORS) -> dict[str, np.ndarray]:
+        """The evidence's factors ``names`` (of :data:`EVIDENCE_FACTORS`, in that order), per grid cell, worked out
+        with the route parameters ``routes``: door depth from the start, the likelihood of the arrows read and that
+        of the signs read that name neither the goal nor an area holding it. A factor with nothing to say (no
+        such arrow or sign read) is left out; door depth is always there."""
+        makers = {"doors": lambda: door_depth_weight(grid, self.start[:2], routes, searches),
+                  "arrows": lambda: route_likelihood(grid, self.arrows(), routes, searches),
+                  "unnamed signs": lambda: passed_likelihood(grid, self.unnamed(), self.start[:2], routes, searches)}
+        found = {name: makers[name]() for name in names}
+        return {name: factor for name, factor in found.items() if factor is not None}
+
     def _evidence(self, grid: OccupancyGrid) -> np.ndarray:
         """Door depth x route likelihood of the arrows read x that of the signs not naming the goal, per grid
         cell; refreshed when a new sign is read or every ``evidence_every_s`` (walls and doors are mapped
@@ -300,15 +316,9 @@ class AbstractMapPolicy(Driven):
         key = (*arrows, *unnamed)
         if self.evidence is None or key != self.evidence_key or self.now - self.evidence_at >= \
                 self.params.routes.evidence_every_s:
-            rp = self.params.routes
-            self.depth = door_depth_weight(grid, self.start[:2], rp, self.searches)
-            found = {"doors": self.depth, "arrows": route_likelihood(grid, arrows, rp, self.searches),
-                     "unnamed signs": passed_likelihood(grid, unnamed, self.start[:2], rp, self.searches)}
-            self.factors = {name: factor for name, factor in found.items() if factor is not None}
-            self.evidence = self.depth
-            for name in ("arrows", "unnamed signs"):
-                if name in self.factors:
-                    self.evidence = self.evidence * self.factors[name]
+            self.factors = self.evidence_factors(grid, self.params.routes, self.searches)
+            self.depth = self.factors["doors"]
+            self.evidence = functools.reduce(np.multiply, self.factors.values())
             self.evidence_key, self.evidence_at = key, self.now
             self.evidence_count += 1
         return self.evidence

@@ -108,12 +108,12 @@ def test_the_script_audits_a_trial_and_resumes_from_its_file(tmp_path, capsys):
 
 def test_the_guided_policy_keeps_its_evidence_as_named_factors_the_audit_can_make_again():
     """The zoo's Kingfisher, until an arrow is read: the evidence is the product of the factors, each named as in
-    FACTORS, and each made again by FACTORS from the same map and cues is the same."""
+    EVIDENCE_FACTORS, and each made again from the same map and cues (as the audit makes a variant) is the same."""
     from dataclasses import replace
 
-    from sim.experiments.evidence_audit import FACTORS
     from sim.experiments.study import study_params
     from sim.experiments.trial import Trial
+    from sim.navigation.policies import EVIDENCE_FACTORS
     from sim.navigation.routes import PathSearches
 
     with Trial("zoo", "Kingfisher", seed=0, perception="geometric", navigator="guided",
@@ -123,9 +123,9 @@ def test_the_guided_policy_keeps_its_evidence_as_named_factors_the_audit_can_mak
             grid = trial.grid.copy()
             trial.step(trial.command())
         assert "arrows" in policy.factors, trial.reason
-        assert set(policy.factors) <= set(FACTORS)
+        assert set(policy.factors) <= set(EVIDENCE_FACTORS)
         product = np.prod(np.stack(list(policy.factors.values())), axis=0)
         np.testing.assert_allclose(policy.evidence, product)
         for name, factor in policy.factors.items():
-            made = FACTORS[name](policy, grid, policy.params.routes, PathSearches())
+            made = policy.evidence_factors(grid, policy.params.routes, PathSearches(), (name,))[name]
             np.testing.assert_allclose(made, factor, err_msg=name)
