@@ -4,9 +4,10 @@ Usage: ``python scripts/evidence_audit.py --world generated:24-43 [--seed 0] [--
 [--variant "arrows: unseen_detour=1.0"] ...`` (development seeds only: the audit knows where each goal hangs).
 
 Runs one guided trial (geometric, as a study runs it) per goal and prints, per factor and per variant (a factor
-made again with other ``RouteParams`` fields, ``"FACTOR: FIELD=VALUE, ..."``), the mean over trials of its
-time-averaged gain (nats; ``sim.experiments.evidence_audit``), the standard error and how many trials it led
-astray by more than half a nat, by signage level. ``--out`` appends one JSON line per trial (resumable).
+made again with other ``RouteParams`` fields, ``"FACTOR: FIELD=VALUE, ..."``, or the whole belief with other
+``BeliefParams`` fields, ``"belief: tail_weight=0.1"``), the mean over trials of its time-averaged gain (nats;
+``sim.experiments.evidence_audit``), the standard error and how many trials it led astray by more than half a
+nat, by signage level. ``--out`` appends one JSON line per trial (resumable).
 """
 
 from __future__ import annotations
@@ -22,35 +23,33 @@ import numpy as np
 from tqdm import tqdm
 
 from abstract_map.errors import AbstractMapError
-from sim.experiments.evidence_audit import AuditRecord, Variant, audit_trial
+from sim.experiments.evidence_audit import BELIEF, AuditRecord, Variant, audit_trial
 from sim.experiments.world_spec import parse_world_spec, resolve_worlds, seed_split
 from sim.navigation.policies import EVIDENCE_FACTORS
-from sim.navigation.routes import RouteParams
 from sim.world.data import load_world
 
 
 def parse_variant(text: str) -> Variant:
-    """``"FACTOR: FIELD=VALUE, ..."`` as a :class:`Variant`; a ValueError says what was expected."""
+    """``"FACTOR: FIELD=VALUE, ..."`` as a :class:`Variant` (FACTOR ``belief`` for the whole belief, with
+    ``BeliefParams`` fields); a ValueError says what was expected."""
     factor, colon, rest = text.partition(":")
-    factor = factor.strip()
-    fields = set(RouteParams.__dataclass_fields__)
-    if not colon or factor not in EVIDENCE_FACTORS:
+    if not colon:
         raise ValueError(f"--variant {text!r}: expected 'FACTOR: FIELD=VALUE, ...' with FACTOR one of "
-                         f"{list(EVIDENCE_FACTORS)}")
+                         f"{[*EVIDENCE_FACTORS, BELIEF]}")
     changes = {}
     for item in filter(None, (p.strip() for p in rest.split(","))):
         key, eq, value = item.partition("=")
-        key = key.strip()
         try:
             number = float(value)
         except ValueError:
             number = math.nan
-        if not eq or key not in fields or not math.isfinite(number):
-            raise ValueError(f"--variant {text!r}: {item!r}; expected FIELD=NUMBER with FIELD a RouteParams field")
-        changes[key] = number
-    if not changes:
-        raise ValueError(f"--variant {text!r}: no FIELD=VALUE given")
-    return Variant(factor, changes)
+        if not eq or not math.isfinite(number):
+            raise ValueError(f"--variant {text!r}: {item!r}; expected FIELD=NUMBER")
+        changes[key.strip()] = number
+    try:
+        return Variant(factor.strip(), changes)
+    except ValueError as exc:
+        raise ValueError(f"--variant {text!r}: {exc}") from None
 
 
 def read_records(path: Path | None) -> dict[tuple[str, str, int], AuditRecord]:
@@ -93,7 +92,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--world", action="append", required=True, help="a world spec, e.g. generated:24-43")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--goals", type=int, default=5, help="goals per world (the study's order)")
-    ap.add_argument("--variant", action="append", default=[], help='e.g. "arrows: unseen_detour=1.0"')
+    ap.add_argument("--variant", action="append", default=[],
+                    help='e.g. "arrows: unseen_detour=1.0" or "belief: tail_weight=0.1"')
     ap.add_argument("--out", type=Path, help="append one JSON line per trial here; trials already in it are kept")
     ap.add_argument("--root", type=Path, default=Path("runs/audit-worlds"), help="where generated worlds are written")
     args = ap.parse_args(argv)

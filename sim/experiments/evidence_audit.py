@@ -21,6 +21,15 @@ same map and cues) is judged against the same ``b_f``:
     gain(f') = log f'(g) - log sum_x b_f(x) f'(x)
 
 so variants can be compared on one run, without a study per setting.
+
+A variant of the whole belief (``belief``: other ``BeliefParams`` fields of
+its prior and of its weighing of space, :data:`BELIEF_FIELDS`) is made again
+from the same map, cues, swept space and evidence, beside the navigator's own
+belief ``b`` made again from the same inputs, and judged by the truth's share:
+
+    gain(b') = log sum_g b'(g) - log sum_g b(g)
+
+nats, the log of the factor by which the variant multiplied the truth's share.
 """
 
 from __future__ import annotations
@@ -33,8 +42,14 @@ from pathlib import Path
 import numpy as np
 
 from sim.mapping.occupancy import OccupancyGrid
-from sim.navigation.policies import EVIDENCE_FACTORS
-from sim.navigation.routes import PathSearches
+from sim.navigation.belief import goal_belief
+from sim.navigation.policies import EVIDENCE_FACTORS, GuidedPolicy
+from sim.navigation.routes import PathSearches, RouteParams
+
+BELIEF = "belief"  # a variant's target when it changes the whole belief rather than one factor
+BELIEF_FIELDS = ("sigma_min_m", "sigma_per_m", "label_offset_m", "prior_misses", "tail_weight", "tail_scale",
+                 "family_sigma_m", "unknown_wall_prob", "detect_prob")  # the BeliefParams fields the belief is made
+# from, given the space swept (the others shape the sweep itself, which a variant does not redo)
 
 
 def gain(belief: np.ndarray, factor: np.ndarray, truth: np.ndarray, variant: np.ndarray | None = None) -> float:
@@ -50,6 +65,14 @@ def gain(belief: np.ndarray, factor: np.ndarray, truth: np.ndarray, variant: np.
     return math.log(max(float(f[truth].max()), tiny)) - math.log(max(float(np.sum(without * f)), tiny))
 
 
+def share_gain(own: np.ndarray, variant: np.ndarray, truth: np.ndarray) -> float:
+    """The gain (nats) of the belief ``variant`` over the belief ``own`` (per cell, each summing to 1) at the
+    ``truth`` cells: the log of the ratio of the truth's shares; NaN when the truth has no cell or either belief
+    puts nothing on it."""
+    a, b = float(own[truth].sum()), float(variant[truth].sum())
+    return math.log(b / a) if truth.any() and a > 0.0 and b > 0.0 else math.nan
+
+
 def truth_cells(grid: OccupancyGrid, labels_xy: np.ndarray, goal_m: float) -> np.ndarray:
     """Bool per cell of ``grid``: within ``goal_m`` (m) of any of the goal's labels (``labels_xy``, (K, 2) m)."""
     xs, ys = grid.cell_axes()
@@ -61,10 +84,22 @@ def truth_cells(grid: OccupancyGrid, labels_xy: np.ndarray, goal_m: float) -> np
 
 @dataclass(frozen=True)
 class Variant:
-    """A factor made again with other route parameters, judged beside the navigator's own."""
+    """A factor made again with other route parameters, or the whole belief with other belief parameters,
+    judged beside the navigator's own."""
 
-    factor: str  # one of sim.navigation.policies.EVIDENCE_FACTORS
-    changes: Mapping[str, float]  # RouteParams fields and their values
+    factor: str  # one of sim.navigation.policies.EVIDENCE_FACTORS, or BELIEF
+    changes: Mapping[str, float]  # RouteParams fields (BELIEF_FIELDS for BELIEF) and their values
+
+    def __post_init__(self) -> None:
+        if self.factor not in (*EVIDENCE_FACTORS, BELIEF):
+            raise ValueError(f"variant {self.name!r}: unknown factor {self.factor!r}; known: "
+                             f"{[*EVIDENCE_FACTORS, BELIEF]}")
+        fields = BELIEF_FIELDS if self.factor == BELIEF else tuple(RouteParams.__dataclass_fields__)
+        wrong = [k for k in self.changes if k not in fields]
+        if wrong or not self.changes:
+            kind = "BeliefParams field of BELIEF_FIELDS" if self.factor == BELIEF else "RouteParams field"
+            raise ValueError(f"variant {self.name!r}: {wrong or 'no change'}; expected FIELD=NUMBER with FIELD a "
+                             f"{kind}")
 
     @property
     def name(self) -> str:
@@ -109,9 +144,8 @@ def audit_trial(world: str | Path, goal: str, *, seed: int = 0, perception: str 
     from sim.experiments.study import study_params
     from sim.experiments.trial import Trial
 
-    for v in variants:
-        if v.factor not in EVIDENCE_FACTORS:
-            raise ValueError(f"variant {v.name!r}: unknown factor {v.factor!r}; known: {list(EVIDENCE_FACTORS)}")
+    factored = [v for v in variants if v.factor != BELIEF]
+    believed = [v for v in variants if v.factor == BELIEF]
     record = AuditRecord(str(world), goal, seed)
     with Trial(world, goal, seed=seed, perception=perception, navigator="guided",
                params=replace(study_params(perception), max_sim_s=max_sim_s)) as trial:
@@ -125,7 +159,7 @@ def audit_trial(world: str | Path, goal: str, *, seed: int = 0, perception: str 
             if policy.evidence_count != made_at:
                 made_at = policy.evidence_count
                 made = {}
-                for v in variants:
+                for v in factored:
                     rp = replace(policy.params.routes, **v.changes)
                     factor = policy.evidence_factors(trial.grid, rp, searches, (v.factor,)).get(v.factor)
                     if factor is not None:
@@ -139,10 +173,29 @@ def audit_trial(world: str | Path, goal: str, *, seed: int = 0, perception: str 
             for name, factor in policy.factors.items():
                 if factor.shape == belief.mass.shape:
                     sample[name] = gain(belief.mass, factor, truth)
-            for v in variants:
+            for v in factored:
                 own = policy.factors.get(v.factor)
                 if v.name in made and own is not None and own.shape == made[v.name].shape == belief.mass.shape:
                     sample[v.name] = gain(belief.mass, own, truth, made[v.name])
+            sample.update(belief_gains(policy, trial.grid, truth, believed))
             record.samples.append(sample)
         record.success, record.distance_m = trial.success, trial.distance
     return record
+
+
+def belief_gains(policy: GuidedPolicy, grid: OccupancyGrid, truth: np.ndarray,
+                 believed: list[Variant]) -> dict[str, float]:
+    """Each belief variant's gain (:func:`share_gain`) over the guided ``policy``'s own belief, both made again
+    on ``grid`` from the policy's latest swept space and evidence, the variant's fields replacing the policy's
+    own. Empty when the policy has no belief on this grid yet."""
+    swept, evidence = policy.belief_swept, policy.evidence
+    if not believed or swept is None or swept.shape != grid.shape or (evidence is not None and
+                                                                       evidence.shape != grid.shape):
+        return {}
+    own = goal_belief(grid, swept, policy.goal_prior(), policy.params.belief, evidence).mass
+    out = {}
+    for v in believed:
+        params = replace(policy.params.belief, **v.changes)
+        out[v.name] = share_gain(own, goal_belief(grid, swept, policy.goal_prior(params), params, evidence).mass,
+                                 truth)
+    return out

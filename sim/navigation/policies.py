@@ -231,13 +231,13 @@ class AbstractMapPolicy(Driven):
     def settles(self) -> list[SettleReport]:
         return self.nav.settles
 
-    def goal_prior(self) -> GoalPrior:
+    def goal_prior(self, belief: BeliefParams | None = None) -> GoalPrior:
         """The goal's imagined position (m; off the map too: a prior's near edge then lies on it), the spread
-        (m) the model earns there (:func:`sim.navigation.belief.goal_sigma`) and the labels read of its
-        siblings (:meth:`family_labels`)."""
+        (m) the model earns there (:func:`sim.navigation.belief.goal_sigma`, with ``belief`` or the policy's own
+        parameters) and the labels read of its siblings (:meth:`family_labels`)."""
         goal = self.nav.model.goal_estimate()
         anchors = np.array([f.xy for f in self.nav.model.fixed.values()])
-        return GoalPrior(goal, goal_sigma(goal, anchors, self.params.belief, self.nav.misses_m),
+        return GoalPrior(goal, goal_sigma(goal, anchors, belief or self.params.belief, self.nav.misses_m),
                          self.family_labels())
 
     def family_labels(self) -> np.ndarray:
@@ -566,6 +566,7 @@ class GuidedPolicy(AbstractMapPolicy):
         frontier = replace(FrontierParams(), min_distance_m=params.guide.min_target_m)
         self.search = FrontierSearch(params, self.drive, frontier, params.guide.rechoose_s)
         self.belief: Belief | None = None  # the latest goal belief, for drawing
+        self.belief_swept: np.ndarray | None = None  # bool per grid cell: counted as looked at in that belief
         self.tags = SpottedTags(params.spotted)
         sp = params.spotted
         self.seen_from_afar: SweptSpace | None = None  # walls seen in the spotting rule: no unseen plate there
@@ -589,8 +590,9 @@ class GuidedPolicy(AbstractMapPolicy):
         """Per grid cell, the goal belief behind it (:func:`sim.navigation.gateways.frontier_values`), and in
         front of each plate seen but unread, the belief on that plate."""
         plates, read = self.tags.tag_cells(grid), self.tags.read_cells(grid)
-        swept = (self._looked_or_seen(covered) & ~plates) | read
-        self.belief = goal_belief(grid, swept, self.goal_prior(), self.params.belief, self._evidence(grid))
+        self.belief_swept = (self._looked_or_seen(covered) & ~plates) | read
+        self.belief = goal_belief(grid, self.belief_swept, self.goal_prior(), self.params.belief,
+                                  self._evidence(grid))
         values = frontier_values(grid, self.belief.mass, covered, robot_xy, self.params.guide, self.params.routes)
         return np.maximum(values, self.tags.zone_values(grid, self.belief.mass))
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from sim.experiments.evidence_audit import Variant, audit_trial, gain, truth_cells
+from sim.experiments.evidence_audit import BELIEF, Variant, audit_trial, gain, share_gain, truth_cells
 from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
 
 
@@ -47,6 +47,35 @@ def test_no_truth_or_no_belief_gives_nan():
     assert math.isnan(gain(np.zeros((2, 2)), b, np.ones((2, 2), dtype=bool)))
 
 
+def test_a_belief_variant_gains_the_log_of_the_truths_share_ratio():
+    truth = np.zeros((2, 2), dtype=bool)
+    truth[0, 1] = True
+    own = np.array([[0.4, 0.1], [0.3, 0.2]])
+    sharper = np.array([[0.1, 0.4], [0.3, 0.2]])
+    assert share_gain(own, sharper, truth) == pytest.approx(math.log(4.0))
+    assert share_gain(sharper, own, truth) == pytest.approx(-math.log(4.0))
+    assert math.isnan(share_gain(own, np.where(truth, 0.0, own), truth))
+    assert math.isnan(share_gain(own, own, np.zeros((2, 2), dtype=bool)))
+
+
+def test_a_belief_variant_takes_only_the_fields_the_belief_is_made_from():
+    assert Variant(BELIEF, {"tail_weight": 0.1}).name == "belief: tail_weight=0.1"
+    for factor, changes in ((BELIEF, {"read_range_m": 3.0}), (BELIEF, {"spread_deg": 10.0}),
+                            ("arrows", {"tail_weight": 0.1}), (BELIEF, {})):
+        with pytest.raises(ValueError, match="expected FIELD=NUMBER"):
+            Variant(factor, changes)
+
+
+def test_a_belief_variant_with_the_navigators_own_parameters_gains_nothing():
+    """The zoo's Kingfisher, a minute of it: the belief made again with its own tail weight is the belief."""
+    record = audit_trial("zoo", "Kingfisher", variants=(Variant(BELIEF, {"tail_weight": 0.3}),
+                                                        Variant(BELIEF, {"tail_weight": 0.05})), max_sim_s=60.0)
+    same = [s["belief: tail_weight=0.3"] for s in record.samples if "belief: tail_weight=0.3" in s]
+    other = [s["belief: tail_weight=0.05"] for s in record.samples if "belief: tail_weight=0.05" in s]
+    assert same and np.allclose(same, 0.0)
+    assert len(other) == len(same) and all(math.isfinite(g) for g in other) and any(abs(g) > 1e-6 for g in other)
+
+
 def test_truth_cells_are_the_cells_near_the_label():
     grid = OccupancyGrid(OccupancyParams(resolution_m=0.1, bounds=(0.0, 2.0, 0.0, 1.0)))
     cells = truth_cells(grid, np.array([[0.55, 0.45]]), 0.15)
@@ -72,8 +101,10 @@ def test_the_script_reads_variants_and_refuses_bad_ones_and_test_seeds(capsys):
     v = script.parse_variant("arrows: unseen_detour=1.0, spread_deg=10")
     assert v.factor == "arrows" and dict(v.changes) == {"unseen_detour": 1.0, "spread_deg": 10.0}
     assert v.name == "arrows: unseen_detour=1, spread_deg=10"
+    assert dict(script.parse_variant("belief: family_sigma_m=4, tail_weight=0.1").changes) == {
+        "family_sigma_m": 4.0, "tail_weight": 0.1}
     for bad in ("compass: spread_deg=1", "arrows spread_deg=1", "arrows: nonsense=1", "arrows: spread_deg=wide",
-                "arrows:"):
+                "arrows:", "belief: spread_deg=10", "belief: read_range_m=3"):
         with pytest.raises(ValueError, match="--variant"):
             script.parse_variant(bad)
     assert script.main(["--world", "generated:1000-1001"]) == 2
