@@ -23,9 +23,8 @@ import numpy as np
 from tqdm import tqdm
 
 from abstract_map.errors import AbstractMapError
-from sim.experiments.evidence_audit import BELIEF, AuditRecord, Variant, audit_trial
+from sim.experiments.evidence_audit import TARGETS, AuditRecord, Variant, audit_trial
 from sim.experiments.world_spec import parse_world_spec, resolve_worlds, seed_split
-from sim.navigation.policies import EVIDENCE_FACTORS
 from sim.world.data import load_world
 
 
@@ -35,7 +34,7 @@ def parse_variant(text: str) -> Variant:
     factor, colon, rest = text.partition(":")
     if not colon:
         raise ValueError(f"--variant {text!r}: expected 'FACTOR: FIELD=VALUE, ...' with FACTOR one of "
-                         f"{[*EVIDENCE_FACTORS, BELIEF]}")
+                         f"{list(TARGETS)}")
     changes = {}
     for item in filter(None, (p.strip() for p in rest.split(","))):
         key, eq, value = item.partition("=")

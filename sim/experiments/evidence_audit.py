@@ -47,6 +47,7 @@ from sim.navigation.policies import EVIDENCE_FACTORS, GuidedPolicy
 from sim.navigation.routes import PathSearches, RouteParams
 
 BELIEF = "belief"  # a variant's target when it changes the whole belief rather than one factor
+TARGETS = (*EVIDENCE_FACTORS, BELIEF)  # what a variant can be made of: one factor, or the whole belief
 BELIEF_FIELDS = ("sigma_min_m", "sigma_per_m", "label_offset_m", "prior_misses", "tail_weight", "tail_scale",
                  "family_sigma_m", "unknown_wall_prob", "detect_prob")  # the BeliefParams fields the belief is made
 # from, given the space swept (the others shape the sweep itself, which a variant does not redo)
@@ -91,9 +92,8 @@ class Variant:
     changes: Mapping[str, float]  # RouteParams fields (BELIEF_FIELDS for BELIEF) and their values
 
     def __post_init__(self) -> None:
-        if self.factor not in (*EVIDENCE_FACTORS, BELIEF):
-            raise ValueError(f"variant {self.name!r}: unknown factor {self.factor!r}; known: "
-                             f"{[*EVIDENCE_FACTORS, BELIEF]}")
+        if self.factor not in TARGETS:
+            raise ValueError(f"variant {self.name!r}: unknown factor {self.factor!r}; known: {list(TARGETS)}")
         fields = BELIEF_FIELDS if self.factor == BELIEF else tuple(RouteParams.__dataclass_fields__)
         wrong = [k for k in self.changes if k not in fields]
         if wrong or not self.changes:

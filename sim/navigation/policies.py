@@ -206,7 +206,6 @@ class AbstractMapPolicy(Driven):
         self.target_at = -float("inf")
         self.bumps = 0  # exploration bumps in all
         self.start = np.asarray(start, dtype=float)
-        self.depth = np.ones(1)  # door-depth weight per grid cell (sim.navigation.routes), set with the belief
         self.evidence: np.ndarray | None = None  # depth x route likelihood, per grid cell
         self.factors: dict[str, np.ndarray] = {}  # the evidence's factors by name (EVIDENCE_FACTORS), per grid cell
         self.evidence_key: tuple = ()  # the arrows and unnamed signs the evidence was worked out from
@@ -308,6 +307,11 @@ class AbstractMapPolicy(Driven):
         found = {name: makers[name]() for name in names}
         return {name: factor for name, factor in found.items() if factor is not None}
 
+    @property
+    def depth(self) -> np.ndarray:
+        """The door-depth weight per grid cell (the evidence's ``doors`` factor); 1 before the first evidence."""
+        return self.factors.get("doors", np.ones(1))
+
     def _evidence(self, grid: OccupancyGrid) -> np.ndarray:
         """Door depth x route likelihood of the arrows read x that of the signs not naming the goal, per grid
         cell; refreshed when a new sign is read or every ``evidence_every_s`` (walls and doors are mapped
@@ -317,7 +321,6 @@ class AbstractMapPolicy(Driven):
         if self.evidence is None or key != self.evidence_key or self.now - self.evidence_at >= \
                 self.params.routes.evidence_every_s:
             self.factors = self.evidence_factors(grid, self.params.routes, self.searches)
-            self.depth = self.factors["doors"]
             self.evidence = functools.reduce(np.multiply, self.factors.values())
             self.evidence_key, self.evidence_at = key, self.now
             self.evidence_count += 1
