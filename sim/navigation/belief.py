@@ -12,10 +12,11 @@ Two grids over the robot's occupancy grid (same cells, world frame, metres):
   Its prior is the abstract map's: a Gaussian about the goal's imagined
   position, its spread growing with how far that position is extrapolated from
   anything observed, mixed with Gaussians about the labels read of the goal's
-  siblings (places of one area hang together). Labels hang on walls, so a
-  cell's prior is weighted by the chance it is wall (1 mapped wall, 0 mapped
-  free, ``unknown_wall_prob`` unseen); swept cells are multiplied by the chance
-  a label there was missed.
+  siblings (places of one area hang together). That is a prior over where the
+  place is; its label hangs on a wall within about ``label_offset_m`` of it, so
+  each place's share goes to the wall near it, shared by wall chance (1 mapped
+  wall, 0 mapped free, ``unknown_wall_prob`` unseen). Swept cells are
+  multiplied by the chance a label there was missed.
 
 See ``docs/method-notes.md`` (negative information) for the equations.
 """
@@ -47,7 +48,8 @@ class BeliefParams:
     sigma_min_m: float = 5.0  # m, spread of the goal's prior even with evidence right beside it: on the development
     # buildings the imagined goal lies a median of several metres from its label, often beyond a wall
     sigma_per_m: float = 0.35  # m of spread per m between the imagined goal and the nearest observed anchor
-    label_offset_m: float = 2.0  # m, a place's label hangs about this far from the place (level-1 label length)
+    label_offset_m: float = 2.0  # m, a place's label hangs about this far from the place (level-1 label length):
+    # the spread of the label about its place, over the wall there
     prior_misses: float = 3.0  # how many of the model's misses (below) the spread from ``sigma_min_m`` and
     # ``sigma_per_m`` counts as: a few labels read decide how far the model is trusted in this building
     tail_weight: float = 0.3  # share of the prior in a wide tail: the model may be wrong (a sign misread, a guess)
@@ -250,12 +252,38 @@ def goal_sigma(goal_xy: np.ndarray, anchors_xy: np.ndarray, params: BeliefParams
     return math.sqrt((n0 * guess ** 2 + float(np.sum(misses ** 2)) / 2) / (n0 + len(misses)))
 
 
+def block_mean(a: np.ndarray, k: int) -> np.ndarray:
+    """Means over ``k`` x ``k`` blocks of ``a`` (the last blocks padded with zeros)."""
+    rows, cols = -(-a.shape[0] // k) * k, -(-a.shape[1] // k) * k
+    padded = np.zeros((rows, cols))
+    padded[:a.shape[0], :a.shape[1]] = a
+    return padded.reshape(rows // k, k, cols // k, k).mean(axis=(1, 3))
+
+
+def labels_near_places(density: np.ndarray, wall: np.ndarray, reach_cells: float) -> np.ndarray:
+    """Per cell, the chance the label hangs there, given ``density`` (per cell) over where its place is and
+    each cell's ``wall`` chance: each place's share goes to the wall about it, in proportion to wall chance
+    times a Gaussian of ``reach_cells`` (cells) about the place,
+    ``w(s) sum_p density(p) K(s - p) / sum_s' w(s') K(s' - p)``.
+
+    So where all about a place is unseen, its share stays in that unseen space, however much mapped wall
+    lies further off. Worked on blocks a quarter of the reach across (two Gaussian filters), exact to the
+    block size; places with no wall within four reaches pass on nothing."""
+    k = max(1, int(reach_cells / 4))
+    reach = reach_cells / k
+    near = ndimage.gaussian_filter(block_mean(wall, k), reach, mode="constant")
+    share = np.divide(block_mean(density, k), near, out=np.zeros(near.shape), where=near > 1e-9)
+    spread = ndimage.gaussian_filter(share, reach, mode="constant")
+    return wall * np.repeat(np.repeat(spread, k, axis=0), k, axis=1)[:wall.shape[0], :wall.shape[1]]
+
+
 def goal_belief(grid: OccupancyGrid, swept: np.ndarray, prior: GoalPrior, params: BeliefParams,
                 evidence: np.ndarray | None = None) -> Belief:
-    """Posterior over the label's cell: prior x evidence x wall chance x (1 - detect_prob on swept cells).
+    """Posterior over the label's cell: the place's prior x evidence, handed to the wall near each place
+    (:func:`labels_near_places`), x (1 - detect_prob on swept cells).
 
-    The prior is :func:`prior_components` (the imagined goal mixed with its
-    siblings' labels) mixed with a wide tail about the imagined goal
+    The place's prior is :func:`prior_components` (the imagined goal mixed with
+    its siblings' labels) mixed with a wide tail about the imagined goal
     (``tail_weight``, ``tail_scale`` times its spread). ``evidence`` (the grid's
     shape, e.g. :func:`sim.navigation.routes.route_likelihood` of the arrows
     read) multiplies it.
@@ -276,7 +304,7 @@ def goal_belief(grid: OccupancyGrid, swept: np.ndarray, prior: GoalPrior, params
     if evidence is not None:
         density *= evidence
     wall = np.where(grid.occupied_mask(), 1.0, np.where(grid.free_mask(), 0.0, params.unknown_wall_prob))
-    weighted = density * wall
+    weighted = labels_near_places(density, wall, params.label_offset_m / grid.resolution)
     posterior = weighted * np.where(swept, 1.0 - params.detect_prob, 1.0)
     reference = float(weighted.sum())
     total = float(posterior.sum())

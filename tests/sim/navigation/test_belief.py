@@ -13,6 +13,7 @@ from sim.navigation.belief import (
     cue_mass,
     goal_belief,
     goal_sigma,
+    labels_near_places,
     prior_components,
     sight_clear,
 )
@@ -131,3 +132,38 @@ def test_belief_moves_to_where_siblings_were_read():
     bottom = wall_cells_at(grid, 1.0)
     assert family.mass[top].sum() > alone.mass[top].sum()
     assert family.mass[bottom].sum() < alone.mass[bottom].sum()
+
+
+def test_a_places_share_goes_to_the_wall_about_it():
+    """One place in unseen space (wall chance 0.05), a mapped wall line 1 m east of it and another 12 m west:
+    the place's whole share stays within reach of it, the near line taking its part by wall chance and the
+    far line none."""
+    wall = np.full((400, 400), 0.05)
+    wall[:, 210] = 1.0  # 1 m east of the place, at 0.1 m cells
+    wall[:, 80] = 1.0  # 12 m west
+    density = np.zeros_like(wall)
+    density[200, 200] = 1.0
+    label = labels_near_places(density, wall, reach_cells=20.0)
+    assert label.sum() == pytest.approx(1.0, abs=1e-3)
+    assert label[:, 80].sum() < 1e-6
+    near_line = label[:, 210].sum()
+    assert 0.15 < near_line < 0.5  # one line of mapped wall against the unseen space about the place
+    assert label[200, 210] > 10 * label[200, 190]  # a mapped cell beside the place outweighs an unseen one
+
+
+def test_mapped_rooms_far_off_do_not_draw_the_belief_from_the_unseen_space_about_the_goal():
+    """The imagined goal at (8, 6) m in unseen space; a mapped block of rooms (walls every metre) 10 m east.
+    Weighting each cell by wall chance alone gave the block 0.12 of the belief; handed out place by place
+    it keeps little more than the prior's mass near the block."""
+    grid = OccupancyGrid(OccupancyParams(resolution_m=0.1, bounds=(0.0, 30.0, 0.0, 12.0)))
+    xy = grid.cell_to_world(np.argwhere(np.ones(grid.shape, dtype=bool)))
+    cells = grid.world_to_cell(xy)
+    block = xy[:, 0] >= 18.0
+    wall = block & (np.mod(xy[:, 0] - 18.0, 1.0) < 0.1)
+    grid.log_odds[cells[block & ~wall, 0], cells[block & ~wall, 1]] = -2.0
+    grid.log_odds[cells[wall, 0], cells[wall, 1]] = 3.0
+    belief = goal_belief(grid, np.zeros(grid.shape, dtype=bool), GoalPrior(np.array([8.0, 6.0]), 5.4),
+                         BeliefParams())
+    east, _ = grid.cell_axes()
+    assert belief.mass[:, east >= 18.0].sum() < 0.1
+    assert belief.mass[:, east < 18.0].sum() > 0.9
