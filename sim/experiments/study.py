@@ -32,6 +32,7 @@ from typing import Any
 from abstract_map.files import write_text_atomic
 from sim.experiments.metrics import oracle_ratio, spl
 from sim.experiments.trial import TrialParams
+from sim.navigation.names import DEFAULT_NAVIGATOR
 from sim.world.data import World
 
 CSV_FIELDS = ["world", "style", "signage", "navigator", "goal", "role", "seed", "perception", "success", "reason",
@@ -59,7 +60,7 @@ class TrialSpec:
     seed: int
     perception: str
     params: TrialParams
-    navigator: str = "paper"
+    navigator: str = DEFAULT_NAVIGATOR
     world_name: str = ""  # the world's name (default: the folder's name)
     oracle_m: float | None = None  # m, the oracle's length from the (un-jittered) start
     style: str = ""  # a generated world's style and signage level ("" for others)
@@ -233,7 +234,7 @@ def make_executor(name: str, workers: int, address: str | None = None) -> Proces
 
 
 def plan_specs(world: World, trials: int, perception: str, *, base: TrialParams | None = None,
-               goals: Iterable[str] | None = None, navigators: Iterable[str] = ("paper",),
+               goals: Iterable[str] | None = None, navigators: Iterable[str] = (DEFAULT_NAVIGATOR,),
                oracle_m: dict[str, float] | None = None) -> list[TrialSpec]:
     """Every goal x navigator x ``trials`` seeds of one world, goals in the world's order."""
     params = study_params(perception, base)

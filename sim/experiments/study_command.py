@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from abstract_map.cli import ExitError
-from sim.navigation.names import navigator_help
+from sim.navigation.names import DEFAULT_NAVIGATOR, navigator_help
 
 SUMMARY = "run every goal of one or more worlds N times per navigator and report (needs [sim])"
 EXTRA = "sim"  # the optional dependencies it needs
@@ -43,7 +43,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "repeatable (default: zoo)")
     parser.add_argument("--trials", type=int, default=5, help="trials per goal and navigator (default 5)")
     parser.add_argument("--navigator", action="append", metavar="NAME",
-                        help=f"{navigator_help('paper')}; repeatable or a comma list, to compare them side "
+                        help=f"{navigator_help(DEFAULT_NAVIGATOR)}; repeatable or a comma list, to compare them side "
                              "by side")
     parser.add_argument("--workers", type=int, default=2, help="parallel trials (default 2)")
     parser.add_argument("--perception", default="camera", choices=["camera", "geometric"])
@@ -59,8 +59,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def navigator_list(values: list[str] | None) -> tuple[str, ...]:
-    """``--navigator`` values, repeated or comma-separated, in order, without repeats (default: paper)."""
-    names = [n.strip() for value in (values or ["paper"]) for n in value.split(",") if n.strip()]
+    """``--navigator`` values, repeated or comma-separated, in order, without repeats (default: guided)."""
+    names = [n.strip() for value in (values or [DEFAULT_NAVIGATOR]) for n in value.split(",") if n.strip()]
     return tuple(dict.fromkeys(names))
 
 

@@ -26,6 +26,7 @@ from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
 from sim.navigation.belief import BeliefParams
 from sim.navigation.follower import FollowerParams
 from sim.navigation.gateways import GuideParams
+from sim.navigation.names import DEFAULT_NAVIGATOR
 from sim.navigation.navigator import CueEvent, NavigatorParams
 from sim.navigation.planner import PlannerParams
 from sim.navigation.policies import NAVIGATORS, PolicyParams, make_policy
@@ -126,7 +127,7 @@ class TrialResult:
     settle_median_ms: float
     frames: list[Frame] = field(default_factory=list, repr=False)
     grid_extent: tuple[float, float, float, float] | None = None
-    navigator: str = "paper"  # the navigation policy's name (sim.navigation.policies.NAVIGATORS)
+    navigator: str = DEFAULT_NAVIGATOR  # the navigation policy's name (sim.navigation.policies.NAVIGATORS)
     cpu_s: float = math.nan  # s of this process's CPU time: unlike wall time, not stretched by a busy machine
     unsettled: int = 0  # settles of the abstract map stopped by its step cap (DynamicsParams.max_iterations)
     explanation: str = ""  # a failure's "kind: particulars" (sim.experiments.diagnosis); "" for a success
@@ -205,8 +206,8 @@ class Trial:
     """
 
     def __init__(self, world: World | str | os.PathLike[str], goal: str, *, seed: int = 0, perception: str = "camera",
-                 navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
-                 record: bool = False, also: Sequence[str] = ()) -> None:
+                 navigator: str = DEFAULT_NAVIGATOR, params: TrialParams | None = None,
+                 progress: Progress | None = None, record: bool = False, also: Sequence[str] = ()) -> None:
         self.began = time.perf_counter()
         self.began_cpu = time.process_time()
         self.world = world if isinstance(world, World) else load_world(world)
@@ -421,7 +422,7 @@ class Trial:
 
 
 def run_trial(world: World | str | os.PathLike[str], goal: str, *, seed: int = 0, perception: str = "camera",
-              navigator: str = "paper", params: TrialParams | None = None, progress: Progress | None = None,
+              navigator: str = DEFAULT_NAVIGATOR, params: TrialParams | None = None, progress: Progress | None = None,
               record: bool = False, log: str | os.PathLike[str] | None = None) -> TrialResult:
     """Run one trial of finding ``goal`` in ``world`` with the navigator driving, and report what happened.
 

@@ -28,7 +28,7 @@ from pathlib import Path
 from abstract_map.cli import ExitError, output_folder
 from abstract_map.errors import integer, number, place_name
 from abstract_map.files import json_text, write_text_atomic
-from sim.navigation.names import navigator_help
+from sim.navigation.names import DEFAULT_NAVIGATOR, navigator_help
 
 SUMMARY = "run one closed-loop trial in a pybullet world (needs the [sim] extra)"
 EXTRA = "sim"  # the optional dependencies it needs
@@ -40,8 +40,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     parser.add_argument("--perception", default="camera", choices=["camera", "geometric"],
                         help="rendered camera + OpenCV AprilTag detector, or the fast geometric check")
-    parser.add_argument("--navigator", default="paper",
-                        help=f"navigation policy: {navigator_help('paper')}")
+    parser.add_argument("--navigator", default=DEFAULT_NAVIGATOR,
+                        help=f"navigation policy: {navigator_help(DEFAULT_NAVIGATOR)}")
     parser.add_argument("--out", type=Path, required=True, help="output folder")
     parser.add_argument("--record", action="store_true", help="also write DIR/run.gif, an animation of the run")
     parser.add_argument("--log", type=Path, metavar="FILE.rrd",

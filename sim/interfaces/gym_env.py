@@ -18,7 +18,10 @@ rate), tags are read at the perception rate (other steps report none).
 The environment's own abstract map listens to the tags read, so ``goal``
 follows the cues whoever drives; its exploration factor never grows (no one
 judges an agent's arrival at the imagined goal; our navigator as a policy keeps
-its own abstract map, which does). Tag ids index
+its own abstract map, which does). ``navigator`` defaults to ``paper``, not the
+trial's default ``guided``: the observation carries no plates seen from afar
+(:mod:`sim.perception.spotting`), which ``guided`` takes in, so through the
+environment it would not drive as it does in a trial. Tag ids index
 the world's tag table (``env.unwrapped.world.tags``); ``info["cues"]`` gives the
 text of the tags read this step.
 """

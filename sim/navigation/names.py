@@ -7,6 +7,9 @@ same order, to the policy classes (tested).
 
 from __future__ import annotations
 
+DEFAULT_NAVIGATOR = "guided"  # the best by the generalisation benchmark (benchmarks/run.py generalise), and within
+# the check on the zoo with the camera; ``paper`` is the paper's robot
+
 NAVIGATOR_SUMMARIES: dict[str, str] = {
     "paper": "the paper's robot: to the goal's imagined position, growing the model when the goal is not there",
     "frontier": "the nearest frontier; reads no sign: the no-signs lower bound",

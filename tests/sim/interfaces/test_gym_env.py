@@ -68,7 +68,7 @@ def test_our_navigator_finds_the_goal_through_the_env_as_in_a_trial(tiny_world):
     assert terminated and not truncated and info["reason"] == "goal label read"
     assert 0 in info["cues"] and info["cues"][0] == "A"
     assert total == pytest.approx(10.0 - info["distance_m"])
-    trial = run_trial(tiny_world, "A", seed=3, perception="geometric")
+    trial = run_trial(tiny_world, "A", seed=3, perception="geometric", navigator=env.unwrapped.navigator)
     assert info["distance_m"] == pytest.approx(trial.distance_m, rel=0.05, abs=0.05)
 
 
