@@ -252,6 +252,12 @@ def goal_sigma(goal_xy: np.ndarray, anchors_xy: np.ndarray, params: BeliefParams
     return math.sqrt((n0 * guess ** 2 + float(np.sum(misses ** 2)) / 2) / (n0 + len(misses)))
 
 
+def wall_chance(occupied: np.ndarray, free: np.ndarray, params: BeliefParams) -> np.ndarray:
+    """Per cell, the chance it carries a label-bearing wall face: 1 mapped wall, 0 mapped free,
+    ``unknown_wall_prob`` unseen."""
+    return np.where(occupied, 1.0, np.where(free, 0.0, params.unknown_wall_prob))
+
+
 def block_mean(a: np.ndarray, k: int) -> np.ndarray:
     """Means over ``k`` x ``k`` blocks of ``a`` (the last blocks padded with zeros)."""
     rows, cols = -(-a.shape[0] // k) * k, -(-a.shape[1] // k) * k
@@ -303,7 +309,7 @@ def goal_belief(grid: OccupancyGrid, swept: np.ndarray, prior: GoalPrior, params
         density += weight / spread ** 2 * np.outer(gy, gx)
     if evidence is not None:
         density *= evidence
-    wall = np.where(grid.occupied_mask(), 1.0, np.where(grid.free_mask(), 0.0, params.unknown_wall_prob))
+    wall = wall_chance(grid.occupied_mask(), grid.free_mask(), params)
     weighted = labels_near_places(density, wall, params.label_offset_m / grid.resolution)
     posterior = weighted * np.where(swept, 1.0 - params.detect_prob, 1.0)
     reference = float(weighted.sum())
@@ -328,7 +334,7 @@ def cue_mass(grid: OccupancyGrid, swept: np.ndarray, robot_xy: np.ndarray, radiu
     rr, cc = np.mgrid[r0:r1, c0:c1]
     near = np.hypot(rr - rc[0], cc - rc[1]) <= reach
     occ, free = grid.occupied_mask()[r0:r1, c0:c1], grid.free_mask()[r0:r1, c0:c1]
-    wall = np.where(occ, 1.0, np.where(free, 0.0, params.unknown_wall_prob))
+    wall = wall_chance(occ, free, params)
     window = near * wall * np.where(swept[r0:r1, c0:c1], 1.0 - params.detect_prob, 1.0)
     total = window.sum()
     if total > 0:
