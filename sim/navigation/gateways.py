@@ -54,6 +54,10 @@ class GuideParams:
     # it to look behind it (the look radius), so a frontier at the robot's feet is not worth without bound
     floor: float = 1e-6  # a value below this share of the best counts as this (nowhere is ruled out)
     rechoose_s: float = 5.0  # s between choosing the frontier afresh (the evidence changes as the map grows)
+    exhausted_remaining: float = 0.5  # grow the abstract map (one exploration step) while less than this share of
+    # the goal's prior is left unswept: the label is not where the model imagines it. Development buildings 24-63:
+    # at the viewpoint search's 0.2 it never grew within 600 s (the tail keeps the unseen building), at 0.65 it
+    # lost, at 0.5 it gained (docs/method-notes.md, "The abstract map grown by the space looked at")
     min_target_m: float = 1.0  # m; frontiers nearer than this by path are skipped (the robot sees them as it goes)
     look_ahead_m: tuple[float, ...] = (0.0, 3.0, 6.0, 12.0, 24.0, 48.0, 96.0)  # m walked past a frontier over which
     # its worth is the best rate of belief per metre (module docstring): doubling steps from one look (3 m) to

@@ -230,6 +230,16 @@ class AbstractMapPolicy(Driven):
     def settles(self) -> list[SettleReport]:
         return self.nav.settles
 
+    def grow_if_used_up(self, belief: Belief, below: float, grid: OccupancyGrid) -> bool:
+        """Negative information fed back into the abstract map: with less than ``below`` of the goal's prior left
+        unswept (``belief.remaining``) the label is not where the model imagines it, so the model grows by one
+        exploration step and settles again (the paper's bump, triggered by the space looked at instead of by
+        arriving at the imagined goal). True when it grew; False too once the bumps in a row run out."""
+        if belief.remaining >= below or not self.nav.arrived_without_goal(grid.explored_centre()):
+            return False
+        self.bumps += 1
+        return True
+
     def goal_prior(self, belief: BeliefParams | None = None) -> GoalPrior:
         """The goal's imagined position (m; off the map too: a prior's near edge then lies on it), the spread
         (m) the model earns there (:func:`sim.navigation.belief.goal_sigma`, with ``belief`` or the policy's own
@@ -502,8 +512,7 @@ class ViewpointPolicy(AbstractMapPolicy):
         self.belief = self._goal_belief(grid, robot_xy)
         # Negative information fed back into the abstract map: the label is not where the model imagines it
         # (one growth step per re-valuing, so the model moves out gradually).
-        if self.belief.remaining < vp.exhausted_remaining and self.nav.arrived_without_goal(grid.explored_centre()):
-            self.bumps += 1
+        if self.grow_if_used_up(self.belief, vp.exhausted_remaining, grid):
             self.belief = self._goal_belief(grid, robot_xy)
         cues = cue_mass(grid, self.swept.swept, robot_xy, vp.cue_radius_m, bp) * self.depth
         mass = self.belief.mass + vp.cue_weight * cues / max(float(cues.sum()), 1e-12)
@@ -558,10 +567,14 @@ class GuidedPolicy(AbstractMapPolicy):
     afar with no plate on them are ruled out, and the space in front of each
     plate seen but not yet read counts as unlooked, so the robot steps in front
     of it (:mod:`sim.navigation.spotted`), and it reads a door's plate before
-    going through the door. The search is complete: it ends when
+    going through the door. While the belief is used up (less than
+    ``GuideParams.exhausted_remaining`` of the prior left unswept) the abstract map
+    grows a step at a time (:meth:`grow_if_used_up`), so the prior moves on from
+    where the label has been looked for. The search is complete: it ends when
     the goal's label is read or no frontier is left.
     """
 
+    feeds_back = True  # grows the abstract map when the belief is used up (False: a prior that is not the model's)
     spots = True  # takes in the plates seen but unread (``observe(..., spotted=...)``); other policies ignore them
 
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
@@ -594,10 +607,16 @@ class GuidedPolicy(AbstractMapPolicy):
         front of each plate seen but unread, the belief on that plate."""
         plates, read = self.tags.tag_cells(grid), self.tags.read_cells(grid)
         self.belief_swept = (self._looked_or_seen(covered) & ~plates) | read
-        self.belief = goal_belief(grid, self.belief_swept, self.goal_prior(), self.params.belief,
-                                  self._evidence(grid))
+        self.belief = self._goal_belief(grid)
+        if self.feeds_back and self.grow_if_used_up(self.belief, self.params.guide.exhausted_remaining, grid):
+            self.belief = self._goal_belief(grid)
         values = frontier_values(grid, self.belief.mass, covered, robot_xy, self.params.guide, self.params.routes)
         return np.maximum(values, self.tags.zone_values(grid, self.belief.mass))
+
+    def _goal_belief(self, grid: OccupancyGrid) -> Belief:
+        """The goal belief over ``grid`` with the space counted as looked at (:attr:`belief_swept`)."""
+        assert self.belief_swept is not None
+        return goal_belief(grid, self.belief_swept, self.goal_prior(), self.params.belief, self._evidence(grid))
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:
@@ -683,6 +702,8 @@ class KnownGoalPolicy(GuidedPolicy):
     beyond it is what not knowing where the goal is costs (``docs/method-notes.md``,
     "The ceiling of a known goal").
     """
+
+    feeds_back = False  # its prior sits on the label, not on the abstract map: growing the model moves nothing
 
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
         super().__init__(world, goal, start, params)

@@ -137,6 +137,30 @@ def test_guided_stands_in_front_of_a_plate_seen_until_it_is_read(tiny_world):
     assert policy.search.unlooked is not None and not policy.search.unlooked.any()
 
 
+@pytest.mark.parametrize("navigator, used_up, grows", [("guided", 1.01, True), ("guided", 0.0, False),
+                                                       ("known-goal", 1.01, False)])
+def test_guided_grows_the_abstract_map_while_its_belief_is_used_up(tiny_world, navigator, used_up, grows):
+    """Negative information into the abstract map: with less than ``exhausted_remaining`` of the prior left
+    unswept, choosing a frontier grows the model one exploration step. ``known-goal``'s prior is the label,
+    not the model, so it never grows it."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    from sim.experiments.trial import TrialParams, occupancy_grid, policy_params
+    from sim.navigation.policies import make_policy
+
+    params = TrialParams()
+    base = policy_params(params)
+    chosen = replace(base, guide=replace(base.guide, exhausted_remaining=used_up))
+    policy = make_policy(navigator, tiny_world, sorted(tiny_world.goals)[0], tiny_world.start, chosen)
+    grid = occupancy_grid(tiny_world, params)
+    policy.command(0.0, tiny_world.start, grid, 0.2, np.random.default_rng(0))
+    assert policy.belief is not None and policy.belief.remaining > 0.9  # nothing looked at yet
+    assert policy.bumps == int(grows)
+    assert (policy.nav.model.exploration_factor > 1.0) == grows
+
+
 def test_guided_reads_a_doors_plate_before_going_through_the_door(tiny_world):
     """A planned path through the gap beside an unread plate turns first to the point in front of the plate;
     once the plate is read the search chooses afresh."""
