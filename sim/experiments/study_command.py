@@ -59,7 +59,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def navigator_list(values: list[str] | None) -> tuple[str, ...]:
-    """``--navigator`` values, repeated or comma-separated, in order, without repeats (default: guided)."""
+    """``--navigator`` values, repeated or comma-separated, in order, without repeats (default: DEFAULT_NAVIGATOR)."""
     names = [n.strip() for value in (values or [DEFAULT_NAVIGATOR]) for n in value.split(",") if n.strip()]
     return tuple(dict.fromkeys(names))
 

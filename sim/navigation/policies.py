@@ -230,15 +230,17 @@ class AbstractMapPolicy(Driven):
     def settles(self) -> list[SettleReport]:
         return self.nav.settles
 
-    def grow_if_used_up(self, belief: Belief, below: float, grid: OccupancyGrid) -> bool:
-        """Negative information fed back into the abstract map: with less than ``below`` of the goal's prior left
-        unswept (``belief.remaining``) the label is not where the model imagines it, so the model grows by one
-        exploration step and settles again (the paper's bump, triggered by the space looked at instead of by
-        arriving at the imagined goal). True when it grew; False too once the bumps in a row run out."""
-        if belief.remaining >= below or not self.nav.arrived_without_goal(grid.explored_centre()):
-            return False
-        self.bumps += 1
-        return True
+    def fed_back_belief(self, grid: OccupancyGrid, swept: np.ndarray, below: float) -> Belief:
+        """The goal belief over ``grid`` with ``swept`` (bool per cell) counted as looked at, negative
+        information fed back into the abstract map: with less than ``below`` of the goal's prior left unswept
+        (``Belief.remaining``) the label is not where the model imagines it, so the model grows by one
+        exploration step, settles again and the belief is made from it (the paper's bump, triggered by the
+        space looked at instead of by arriving at the imagined goal; none once the bumps in a row run out)."""
+        belief = goal_belief(grid, swept, self.goal_prior(), self.params.belief, self._evidence(grid))
+        if belief.remaining < below and self.nav.arrived_without_goal(grid.explored_centre()):
+            self.bumps += 1
+            belief = goal_belief(grid, swept, self.goal_prior(), self.params.belief, self._evidence(grid))
+        return belief
 
     def goal_prior(self, belief: BeliefParams | None = None) -> GoalPrior:
         """The goal's imagined position (m; off the map too: a prior's near edge then lies on it), the spread
@@ -501,19 +503,12 @@ class ViewpointPolicy(AbstractMapPolicy):
             self.target = None
         return v, w
 
-    def _goal_belief(self, grid: OccupancyGrid, robot_xy: np.ndarray) -> Belief:
-        assert self.swept is not None
-        return goal_belief(grid, self.swept.swept, self.goal_prior(), self.params.belief, self._evidence(grid))
-
     def _retarget(self, t_s: float, robot_xy: np.ndarray, grid: OccupancyGrid) -> None:
         """Choose the viewpoint reading the most belief per metre; grow the model while the belief is used up."""
         vp, bp = self.params.viewpoints, self.params.belief
         assert self.swept is not None
-        self.belief = self._goal_belief(grid, robot_xy)
-        # Negative information fed back into the abstract map: the label is not where the model imagines it
-        # (one growth step per re-valuing, so the model moves out gradually).
-        if self.grow_if_used_up(self.belief, vp.exhausted_remaining, grid):
-            self.belief = self._goal_belief(grid, robot_xy)
+        # One growth step at most per re-valuing, so the model moves out gradually.
+        self.belief = self.fed_back_belief(grid, self.swept.swept, vp.exhausted_remaining)
         cues = cue_mass(grid, self.swept.swept, robot_xy, vp.cue_radius_m, bp) * self.depth
         mass = self.belief.mass + vp.cue_weight * cues / max(float(cues.sum()), 1e-12)
         travel = travel_costs(grid, robot_xy, self.params.planner, vp.escape_cost, pool=vp.travel_pool)
@@ -569,7 +564,7 @@ class GuidedPolicy(AbstractMapPolicy):
     of it (:mod:`sim.navigation.spotted`), and it reads a door's plate before
     going through the door. While the belief is used up (less than
     ``GuideParams.exhausted_remaining`` of the prior left unswept) the abstract map
-    grows a step at a time (:meth:`grow_if_used_up`), so the prior moves on from
+    grows a step at a time (:meth:`fed_back_belief`), so the prior moves on from
     where the label has been looked for. The search is complete: it ends when
     the goal's label is read or no frontier is left.
     """
@@ -607,16 +602,10 @@ class GuidedPolicy(AbstractMapPolicy):
         front of each plate seen but unread, the belief on that plate."""
         plates, read = self.tags.tag_cells(grid), self.tags.read_cells(grid)
         self.belief_swept = (self._looked_or_seen(covered) & ~plates) | read
-        self.belief = self._goal_belief(grid)
-        if self.feeds_back and self.grow_if_used_up(self.belief, self.params.guide.exhausted_remaining, grid):
-            self.belief = self._goal_belief(grid)
+        self.belief = self.fed_back_belief(grid, self.belief_swept,
+                                           self.params.guide.exhausted_remaining if self.feeds_back else 0.0)
         values = frontier_values(grid, self.belief.mass, covered, robot_xy, self.params.guide, self.params.routes)
         return np.maximum(values, self.tags.zone_values(grid, self.belief.mass))
-
-    def _goal_belief(self, grid: OccupancyGrid) -> Belief:
-        """The goal belief over ``grid`` with the space counted as looked at (:attr:`belief_swept`)."""
-        assert self.belief_swept is not None
-        return goal_belief(grid, self.belief_swept, self.goal_prior(), self.params.belief, self._evidence(grid))
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:
