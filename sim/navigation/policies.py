@@ -41,7 +41,7 @@ from typing import Protocol
 
 import numpy as np
 
-from abstract_map.clauses import Locational
+from abstract_map.clauses import Clause, Locational
 from abstract_map.model import SettleReport, imagined_positions
 from sim.mapping.occupancy import OccupancyGrid
 from sim.navigation.belief import Belief, BeliefParams, GoalPrior, SweptSpace, cue_mass, goal_belief, goal_sigma
@@ -255,19 +255,19 @@ class AbstractMapPolicy(Driven):
         """(K, 2) m: where the labels read of the goal's siblings hang (places with the goal's parent area,
         the goal excluded); none when the goal has no parent or its parent is the hierarchy's root (the
         whole building is no area)."""
-        model, parents = self.nav.model, self.nav.model.hierarchy.parent
+        model, siblings = self.nav.model, self._siblings()
+        out = [model.fixed[anchor].xy for anchor, clauses in model.cue_clauses.items() for c in clauses
+               if isinstance(c, Locational) and c.kind == "label" and model.canonical(c.toponym) in siblings]
+        return np.array(out, dtype=float).reshape(-1, 2)
+
+    def _siblings(self) -> set[str]:
+        """The places sharing the goal's parent area, the goal excluded; none when the goal has no parent or its
+        parent is the hierarchy's root (the whole building is no area)."""
+        parents = self.nav.model.hierarchy.parent
         area = parents.get(self.nav.goal)
         if area is None or area not in parents:
-            return np.zeros((0, 2))
-        out = []
-        for anchor, clauses in model.cue_clauses.items():
-            for c in clauses:
-                if not (isinstance(c, Locational) and c.kind == "label"):
-                    continue
-                name = model.canonical(c.toponym)
-                if name != self.nav.goal and parents.get(name) == area:
-                    out.append(model.fixed[anchor].xy)
-        return np.array(out, dtype=float).reshape(-1, 2)
+            return set()
+        return {name for name, parent in parents.items() if parent == area and name != self.nav.goal}
 
     def _areas(self) -> set[str]:
         """The places that hold the goal, up the hierarchy."""
@@ -278,22 +278,36 @@ class AbstractMapPolicy(Driven):
         return areas
 
     def arrows(self) -> list[Arrow]:
-        """Every arrow read that names the goal, or an area holding it (less surely)."""
-        model, rp = self.nav.model, self.params.routes
-        areas = self._areas()
-        out = []
+        """One arrow per sign and direction read that names the goal, or (less surely) an area holding it or a
+        sibling: a place of the goal's area, whose route leads into that area as an area's own arrow does (to one
+        of its rooms). A sibling's arrow counts only on a sign that does not name the goal itself (in an arrow or
+        a phrase): there the sign has said where the goal is, and its siblings' ways are their own. An arrow
+        naming several of them is one statement of a way, as sure as its surest name."""
+        model, rp, goal = self.nav.model, self.params.routes, self.nav.goal
+        areas, siblings = self._areas(), self._siblings()
+        naming_goal = {anchor for anchor, clauses in model.cue_clauses.items() if goal in self._names(clauses)}
+        surest: dict[tuple[str, float], float] = {}
         for clause in model.clauses():
             if not isinstance(clause, Locational) or clause.kind != "arrow" or clause.anchor not in model.fixed:
                 continue
-            if clause.toponym == self.nav.goal or clause.toponym in areas:
-                sign = model.fixed[clause.anchor]
-                wrong = rp.wrong_prob if clause.toponym == self.nav.goal else rp.area_wrong_prob
-                out.append(Arrow((sign.x, sign.y), sign.theta, clause.direction, wrong))
-        return out
+            name = model.canonical(clause.toponym)
+            if name == goal or name in areas or (name in siblings and clause.anchor not in naming_goal):
+                key = (clause.anchor, clause.direction)
+                surest[key] = min(rp.wrong_prob if name == goal else rp.area_wrong_prob, surest.get(key, 1.0))
+        signs = model.fixed
+        return [Arrow((signs[a].x, signs[a].y), signs[a].theta, direction, wrong)
+                for (a, direction), wrong in surest.items()]
+
+    def _names(self, clauses: Iterable[Clause]) -> set[str]:
+        """Every place ``clauses`` name (canonical spelling), in arrows, labels and phrases."""
+        model = self.nav.model
+        return {model.canonical(name) for c in clauses for name in (
+            (c.toponym,) if isinstance(c, Locational) else (c.figure, *c.referents, c.context)) if name}
 
     def unnamed(self) -> list[tuple[float, float]]:
         """Where the reader of each sign read stands (m, ``RouteParams.stand_m`` in front of it) that has an
-        arrow and names neither the goal nor an area holding it, in an arrow or a phrase."""
+        arrow and names neither the goal nor an area holding it, in an arrow or a phrase (a sibling named does
+        not count: signs on a place's route name it or its area, ``RouteParams.named_prob``)."""
         model, stand = self.nav.model, self.params.routes.stand_m
         wanted = self._areas() | {self.nav.goal}
         out = []
@@ -301,9 +315,7 @@ class AbstractMapPolicy(Driven):
             sign = model.fixed.get(anchor)
             if sign is None or not any(isinstance(c, Locational) and c.kind == "arrow" for c in clauses):
                 continue
-            named = {name for c in clauses for name in (
-                (c.toponym,) if isinstance(c, Locational) else (c.figure, *c.referents, c.context))}
-            if not {model.canonical(name) for name in named if name} & wanted:
+            if not self._names(clauses) & wanted:
                 out.append((sign.x + stand * math.cos(sign.theta), sign.y + stand * math.sin(sign.theta)))
         return out
 

@@ -74,8 +74,9 @@ class RouteParams:
     unseen_reach_m: float = 15.0  # m from the reader within which unseen space can turn a route's first leg: the
     # walls of about one block between corridors (10-20 m in most buildings)
     wrong_prob: float = 0.1  # chance an arrow naming the goal is wrong ("misleading" signage: one in ten)
-    area_wrong_prob: float = 0.35  # for an arrow naming an area holding the goal: the goal may lie off the
-    # area's route (a wing's arrow leads to its nearest room, not to every room of it)
+    area_wrong_prob: float = 0.35  # for an arrow naming an area holding the goal, or a sibling on a sign that does
+    # not name the goal: the goal may lie off that route (a wing's arrow leads to its nearest room, a sibling's to
+    # that room, not to every room of the wing)
     named_prob: float = 0.7  # chance that a sign on the goal's route names it or an area holding it: the generator's
     # complete signage names all 159 of seeds 0-4 (worlds/README.md), its sparse signage half by area only; hand-made
     # buildings name fewer (the zoo's signs list a few places each)

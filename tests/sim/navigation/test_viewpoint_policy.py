@@ -109,6 +109,44 @@ def test_family_labels_are_the_goals_siblings_read(tmp_path):
     assert np.isfinite(read).all()
 
 
+def test_an_arrow_naming_a_sibling_leads_into_the_goals_area(tmp_path):
+    """An arrow naming a place of the goal's area counts as the area's arrow (``area_wrong_prob``) unless its
+    sign names the goal itself; an arrow naming another area's place does not count. A sign naming a sibling
+    alone still names neither the goal nor an area holding it. One line naming several of them is one arrow,
+    as sure as its surest name."""
+    import math
+
+    from abstract_map.hierarchy import Hierarchy
+    from sim.experiments.trial import TrialParams, policy_params
+    from sim.navigation.policies import GuidedPolicy
+    from sim.world.data import load_world
+    from sim.world.generator import generated_world
+
+    world = load_world(generated_world(0, style="office", size="medium", signage="complete", root=tmp_path))
+    parent = Hierarchy.from_xml(world.hierarchy_path).parent
+    goal = sorted(world.goals)[0]
+    area = parent[goal]
+    sibling, sibling2 = sorted(p for p, a in parent.items() if a == area and p != goal)[:2]
+    stranger = sorted(p for p, a in parent.items() if a in parent and a not in (area, goal) and p != area)[0]
+    params = policy_params(TrialParams())
+    routes = params.routes
+    policy = GuidedPolicy(world, goal, world.start, params)
+    model = policy.nav.model
+    model.observe_tag(900, f"$LEFT$ {sibling}, {sibling2}", (1.0, 2.0, 0.0), kind="sign")
+    model.observe_tag(901, f"$RIGHT$ {stranger}", (5.0, 2.0, math.pi), kind="sign")
+    arrows = policy.arrows()
+    assert [(a.sign_xy, a.wrong_prob) for a in arrows] == [((1.0, 2.0), routes.area_wrong_prob)]
+    assert math.isclose(arrows[0].direction % (2 * math.pi), 3 * math.pi / 2)  # LEFT of a sign facing +x
+    assert len(policy.unnamed()) == 2  # a sibling's sign, like a stranger's, is not on the goal's route
+    model.observe_tag(902, f"$UP$ {area}, {sibling}\n$DOWN$ {sibling}, {area}, {goal}", (1.0, 8.0, 0.0), kind="sign")
+    model.observe_tag(903, f"$UP$ {sibling}\nThe {goal} is near the {sibling}", (9.0, 8.0, 0.0), kind="sign")
+    by_sign = {}
+    for a in policy.arrows():
+        by_sign.setdefault(a.sign_xy, []).append((round(a.direction % (2 * math.pi), 6), a.wrong_prob))
+    assert sorted(by_sign[(1.0, 8.0)]) == [(0.0, routes.wrong_prob), (round(math.pi, 6), routes.area_wrong_prob)]
+    assert (9.0, 8.0) not in by_sign  # it names the goal: its sibling's way is the sibling's own
+
+
 def test_guided_stands_in_front_of_a_plate_seen_until_it_is_read(tiny_world):
     """A plate seen but unread opens a reading zone the search goes to; reading it closes the zone."""
     import numpy as np
