@@ -41,7 +41,7 @@ from typing import Protocol
 
 import numpy as np
 
-from abstract_map.clauses import Clause, Locational
+from abstract_map.clauses import Clause, Locational, clause_names, is_anchor
 from abstract_map.model import SettleReport, imagined_positions
 from sim.mapping.occupancy import OccupancyGrid
 from sim.navigation.belief import Belief, BeliefParams, GoalPrior, SweptSpace, cue_mass, goal_belief, goal_sigma
@@ -301,8 +301,7 @@ class AbstractMapPolicy(Driven):
     def _names(self, clauses: Iterable[Clause]) -> set[str]:
         """Every place ``clauses`` name (canonical spelling), in arrows, labels and phrases."""
         model = self.nav.model
-        return {model.canonical(name) for c in clauses for name in (
-            (c.toponym,) if isinstance(c, Locational) else (c.figure, *c.referents, c.context)) if name}
+        return {model.canonical(name) for c in clauses for name in clause_names(c) if not is_anchor(name)}
 
     def unnamed(self) -> list[tuple[float, float]]:
         """Where the reader of each sign read stands (m, ``RouteParams.stand_m`` in front of it) that has an
