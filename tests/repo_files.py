@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import importlib.util
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from types import ModuleType
+
+import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -21,3 +23,15 @@ def load_file(relative: str, name: str,
     register(name, module)
     spec.loader.exec_module(module)
     return module
+
+
+def refused_in_one_line(main: Callable[[Sequence[str]], int], argv: Sequence[str], capsys: pytest.CaptureFixture,
+                        prog: str) -> str:
+    """What a script's ``main`` printed on refusing ``argv``, after checking it exited 2 with one line on stderr
+    that starts with ``prog: ``."""
+    with pytest.raises(SystemExit) as exited:
+        main(argv)
+    assert exited.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"{prog}: ") and err.count("\n") == 1
+    return err

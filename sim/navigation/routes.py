@@ -76,7 +76,9 @@ class RouteParams:
     wrong_prob: float = 0.1  # chance an arrow naming the goal is wrong ("misleading" signage: one in ten)
     area_wrong_prob: float = 0.35  # for an arrow naming an area holding the goal, or a sibling on a sign that does
     # not name the goal: the goal may lie off that route (a wing's arrow leads to its nearest room, a sibling's to
-    # that room, not to every room of the wing)
+    # that room, not to every room of the wing). On the full plan (scripts/area_arrows.py) an area's arrow sets off
+    # another way than the route to 24% of its rooms on development buildings 0-47 (the zoo: 7%), a sibling's 17%
+    # (the zoo: 38%); a route read off the robot's half-mapped floor is less sure (0.2 screened, not kept)
     named_prob: float = 0.7  # chance that a sign on the goal's route names it or an area holding it: the generator's
     # complete signage names all 159 of seeds 0-4 (worlds/README.md), its sparse signage half by area only; hand-made
     # buildings name fewer (the zoo's signs list a few places each)

@@ -7,7 +7,7 @@ import math
 import pytest
 
 from sim.world.data import Tag, load_world
-from tests.repo_files import load_file
+from tests.repo_files import load_file, refused_in_one_line
 
 
 def load():
@@ -36,8 +36,4 @@ def test_the_zoo_arrows_place_their_labels_to_a_few_metres(capsys):
 
 
 def test_a_world_that_is_not_there_is_one_line_and_exit_2(capsys, tmp_path):
-    with pytest.raises(SystemExit) as exited:
-        load().main(["--world", str(tmp_path / "nowhere")])
-    assert exited.value.code == 2
-    err = capsys.readouterr().err
-    assert err.startswith("arrow_spread: ") and err.count("\n") == 1 and "nowhere" in err
+    assert "nowhere" in refused_in_one_line(load().main, ["--world", str(tmp_path / "nowhere")], capsys, "arrow_spread")
