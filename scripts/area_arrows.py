@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import math
 from collections import Counter, defaultdict
+from collections.abc import Mapping
 
 from tqdm import tqdm
 
@@ -30,38 +31,25 @@ from abstract_map.hierarchy import Hierarchy
 from sim.experiments.world_spec import parse_world_spec
 from sim.world.data import Tag, World, load_world
 from sim.world.generator import generate
-from sim.world.truth import Routes, first_leg
+from sim.world.truth import Routes, first_leg, place_tags
 
 KINDS = ("area", "area, also named", "sibling", "sibling, also named")
 
 
-def rooms_led_to(name: str, hierarchy: Hierarchy, labelled: set[str]) -> tuple[str, list[str]] | None:
-    """The kind of place ``name`` is to an arrow and the labelled rooms its arrow is read to lead towards:
-    ("area", every labelled place under it) or ("sibling", the other labelled places of its parent area);
-    None for the building's root or a place whose parent is the root."""
+def rooms_led_to(name: str, hierarchy: Hierarchy, tags: Mapping[int, Tag]) -> tuple[str, list[str]] | None:
+    """The kind of place ``name`` is to an arrow and the rooms with a label among ``tags`` its arrow is read to
+    lead towards: ("area", every such place in it, by :func:`sim.world.truth.place_tags`) or ("sibling", the other
+    such places of its parent area); None for the building's root or a place whose parent is the root."""
     parent = hierarchy.parent
     if name not in parent:
         return None
-    under = _descendants(name, parent)
-    if under:
-        return "area", sorted(under & labelled)
+    if hierarchy.children(name):
+        return "area", sorted({t.text for t in place_tags(name, hierarchy, tags)} - {name})
     area = parent[name]
     if area not in parent:
         return None
+    labelled = {t.text for t in tags.values() if t.kind == "label"}
     return "sibling", sorted(p for p, up in parent.items() if up == area and p != name and p in labelled)
-
-
-def _descendants(name: str, parent: dict[str, str]) -> set[str]:
-    children: dict[str, list[str]] = defaultdict(list)
-    for child, up in parent.items():
-        children[up].append(child)
-    found, todo = set(), [name]
-    while todo:
-        for child in children[todo.pop()]:
-            if child not in found:
-                found.add(child)
-                todo.append(child)
-    return found
 
 
 def route_agreement(world: World, hierarchy: Hierarchy) -> Counter[tuple[str, bool]]:
@@ -84,7 +72,7 @@ def route_agreement(world: World, hierarchy: Hierarchy) -> Counter[tuple[str, bo
             continue
         named = {c.toponym for c in arrows}
         for clause in arrows:
-            led = rooms_led_to(clause.toponym, hierarchy, set(labels))
+            led = rooms_led_to(clause.toponym, hierarchy, world.tags)
             if led is None:
                 continue
             kind, rooms = led

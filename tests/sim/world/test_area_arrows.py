@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 
 from abstract_map.hierarchy import Hierarchy
-from sim.world.data import load_world
+from sim.world.data import Tag, load_world
 from tests.repo_files import load_file, refused_in_one_line
 
 XML = """<hierarchy><place name="Building">
@@ -24,13 +24,14 @@ def load():
 def test_an_area_leads_to_every_labelled_room_under_it_and_a_room_to_its_siblings():
     script = load()
     hierarchy = Hierarchy.from_xml_string(XML)
-    labelled = {"X-Ray Room", "Scan Room", "Pharmacy", "Lobby"}
-    assert script.rooms_led_to("West Wing", hierarchy, labelled) == ("area", ["Pharmacy", "Scan Room", "X-Ray Room"])
-    assert script.rooms_led_to("Radiology", hierarchy, labelled) == ("area", ["Scan Room", "X-Ray Room"])
-    assert script.rooms_led_to("X-Ray Room", hierarchy, labelled) == ("sibling", ["Scan Room"])
-    assert script.rooms_led_to("Building", hierarchy, labelled) is None  # the root: no area
-    assert script.rooms_led_to("Lobby", hierarchy, labelled) is None  # its parent is the root
-    assert script.rooms_led_to("Nowhere", hierarchy, labelled) is None
+    tags = {i: Tag(i, float(i), 0.0, 0.0, "label", name)
+                for i, name in enumerate(["X-Ray Room", "Scan Room", "Pharmacy", "Lobby"])}
+    assert script.rooms_led_to("West Wing", hierarchy, tags) == ("area", ["Pharmacy", "Scan Room", "X-Ray Room"])
+    assert script.rooms_led_to("Radiology", hierarchy, tags) == ("area", ["Scan Room", "X-Ray Room"])
+    assert script.rooms_led_to("X-Ray Room", hierarchy, tags) == ("sibling", ["Scan Room"])
+    assert script.rooms_led_to("Building", hierarchy, tags) is None  # the root: no area
+    assert script.rooms_led_to("Lobby", hierarchy, tags) is None  # its parent is the root
+    assert script.rooms_led_to("Nowhere", hierarchy, tags) is None
 
 
 def test_the_zoos_area_arrows_lead_to_their_enclosures_and_its_sibling_arrows_do_not(capsys):
