@@ -7,10 +7,12 @@ never start with ``#``.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 ANCHOR_PREFIX = "#"
 START_ANCHOR = "#start"
+NAMED_BY = ("phrase", "arrow", "hierarchy")  # how cues name a place, the surest way first (:func:`named_by`)
 
 
 def tag_anchor(tag_id: int) -> str:
@@ -77,3 +79,15 @@ def clause_names(clause: Clause) -> list[str]:
     if isinstance(clause, Relational):
         return [clause.figure, *clause.referents, *([clause.context] if clause.context else [])]
     return [clause.toponym, clause.anchor]
+
+
+def named_by(clauses: Iterable[Clause], place: str, canonical: Callable[[str], str] = str) -> str:
+    """How ``clauses`` name ``place``, the surest way (:data:`NAMED_BY`): ``"phrase"`` when a relational
+    clause has it as its figure or a referent, else ``"arrow"`` when an arrow points to it, else
+    ``"hierarchy"`` (no cue names it: only the hierarchy places it). Names are compared after ``canonical``."""
+    arrow = False
+    for c in clauses:
+        if isinstance(c, Relational) and place in {canonical(n) for n in (c.figure, *c.referents)}:
+            return "phrase"
+        arrow = arrow or (isinstance(c, Locational) and c.kind == "arrow" and canonical(c.toponym) == place)
+    return "arrow" if arrow else "hierarchy"

@@ -48,9 +48,10 @@ from sim.navigation.routes import PathSearches, RouteParams
 
 BELIEF = "belief"  # a variant's target when it changes the whole belief rather than one factor
 TARGETS = (*EVIDENCE_FACTORS, BELIEF)  # what a variant can be made of: one factor, or the whole belief
-BELIEF_FIELDS = ("sigma_min_m", "sigma_per_m", "label_offset_m", "prior_misses", "tail_weight", "tail_scale",
-                 "family_sigma_m", "unknown_wall_prob", "detect_prob")  # the BeliefParams fields the belief is made
-# from, given the space swept (the others shape the sweep itself, which a variant does not redo)
+BELIEF_FIELDS = ("sigma_min_m", "sigma_min_arrow_m", "sigma_min_hierarchy_m", "sigma_per_m", "label_offset_m",
+                 "prior_misses", "tail_weight", "tail_scale", "family_sigma_m", "unknown_wall_prob",
+                 "detect_prob")  # the BeliefParams fields the belief is made from, given the space swept (the
+# others shape the sweep itself, which a variant does not redo)
 
 
 def gain(belief: np.ndarray, factor: np.ndarray, truth: np.ndarray, variant: np.ndarray | None = None) -> float:

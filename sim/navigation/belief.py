@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import ndimage
 
+from abstract_map.clauses import NAMED_BY
 from sim.mapping.occupancy import OccupancyGrid
 
 
@@ -45,8 +46,13 @@ class BeliefParams:
     normal_smoothing_m: float = 0.2  # m, std of the smoothing of the wall-orientation (structure) tensor
     corner_coherence: float = 0.3  # below this wall-orientation coherence (corners, specks) any view angle counts
     unknown_wall_prob: float = 0.05  # chance an unseen cell holds a label-bearing wall face, against a mapped face's 1
-    sigma_min_m: float = 5.0  # m, spread of the goal's prior even with evidence right beside it: on the development
-    # buildings the imagined goal lies a median of several metres from its label, often beyond a wall
+    sigma_min_m: float = 5.0  # m, spread of the goal's prior even with evidence right beside it, for a goal a
+    # phrase read names (its figure or a referent): held out on development buildings 12-35 the model places such
+    # a place 7.4 m rms from its label, sqrt(7.4^2 / 2 - label_offset_m^2) = 4.9 m a side
+    # (scripts/placement_by_cue.py)
+    sigma_min_arrow_m: float = 8.4  # m, the same for a goal only arrows read name: 12.2 m rms there
+    sigma_min_hierarchy_m: float = 9.9  # m, the same for a goal no cue read names (the hierarchy alone places
+    # it): 14.2 m rms there
     sigma_per_m: float = 0.35  # m of spread per m between the imagined goal and the nearest observed anchor
     label_offset_m: float = 2.0  # m, a place's label hangs about this far from the place (level-1 label length):
     # the spread of the label about its place, over the wall there
@@ -57,6 +63,14 @@ class BeliefParams:
     family_sigma_m: float = 6.5  # m, spread of a place's label about a sibling's (same parent area) label: the
     # per-axis rms of sibling label distances on development buildings 0-99 is 6.6-6.8 m
     # (scripts/sibling_spread.py)
+
+    def floor_m(self, placed_by: str) -> float:
+        """The least spread (m) of the prior of a goal the cues read name ``placed_by`` (one of
+        :data:`abstract_map.clauses.NAMED_BY`)."""
+        floors = {"phrase": self.sigma_min_m, "arrow": self.sigma_min_arrow_m, "hierarchy": self.sigma_min_hierarchy_m}
+        if placed_by not in floors:
+            raise ValueError(f"placed_by must be one of {NAMED_BY}, got {placed_by!r}")
+        return floors[placed_by]
 
 
 @dataclass(frozen=True)
@@ -235,18 +249,20 @@ class Belief:
 
 
 def goal_sigma(goal_xy: np.ndarray, anchors_xy: np.ndarray, params: BeliefParams,
-               misses_m: Sequence[float] = ()) -> float:
+               misses_m: Sequence[float] = (), placed_by: str = "phrase") -> float:
     """Spread (m) of the goal's prior.
 
     Before any miss, the label offset in quadrature with a share of the distance to the nearest observed anchor
-    (a tag read, or the start), at least ``sigma_min_m``. ``misses_m`` are the model's own misses in this
+    (a tag read, or the start), at least the floor for how the cues read name the goal (``placed_by``:
+    :meth:`BeliefParams.floor_m`; a phrase places a place about twice as well as the hierarchy alone, an arrow
+    between the two). ``misses_m`` are the model's own misses in this
     building (m): how far each label read lay from where the model imagined its place just before. They
     replace that guess as they come: with ``n`` misses ``e_i`` and the guess counted as ``prior_misses`` of
     them, ``sigma^2 = (n0 guess^2 + sum e_i^2 / 2) / (n0 + n)`` (a miss in the plane has mean square
     ``2 sigma^2``)."""
     anchors = np.atleast_2d(np.asarray(anchors_xy, dtype=float))
     nearest = float(np.min(np.hypot(*(anchors - goal_xy).T))) if anchors.size else 0.0
-    spread = max(params.sigma_min_m, params.sigma_per_m * nearest)
+    spread = max(params.floor_m(placed_by), params.sigma_per_m * nearest)
     guess = math.hypot(spread, params.label_offset_m)
     n0, misses = params.prior_misses, np.asarray(misses_m, dtype=float)
     return math.sqrt((n0 * guess ** 2 + float(np.sum(misses ** 2)) / 2) / (n0 + len(misses)))

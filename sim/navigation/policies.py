@@ -41,7 +41,7 @@ from typing import Protocol
 
 import numpy as np
 
-from abstract_map.clauses import Clause, Locational, clause_names, is_anchor
+from abstract_map.clauses import Clause, Locational, clause_names, is_anchor, named_by
 from abstract_map.model import SettleReport, imagined_positions
 from sim.mapping.occupancy import OccupancyGrid
 from sim.navigation.belief import Belief, BeliefParams, GoalPrior, SweptSpace, cue_mass, goal_belief, goal_sigma
@@ -248,8 +248,14 @@ class AbstractMapPolicy(Driven):
         parameters) and the labels read of its siblings (:meth:`family_labels`)."""
         goal = self.nav.model.goal_estimate()
         anchors = np.array([f.xy for f in self.nav.model.fixed.values()])
-        return GoalPrior(goal, goal_sigma(goal, anchors, belief or self.params.belief, self.nav.misses_m),
-                         self.family_labels())
+        return GoalPrior(goal, goal_sigma(goal, anchors, belief or self.params.belief, self.nav.misses_m,
+                                          self.placed_by()), self.family_labels())
+
+    def placed_by(self) -> str:
+        """How the cues read so far name the goal, the surest way (:func:`abstract_map.clauses.named_by`)."""
+        model = self.nav.model
+        return named_by((c for clauses in model.cue_clauses.values() for c in clauses), self.nav.goal,
+                        model.canonical)
 
     def family_labels(self) -> np.ndarray:
         """(K, 2) m: where the labels read of the goal's siblings hang (places with the goal's parent area,

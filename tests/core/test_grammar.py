@@ -129,3 +129,17 @@ def test_arrow_without_a_pose_is_an_error():
 def test_nan_anchor_is_an_error():
     with pytest.raises(CueError, match="finite"):
         Anchor("#1", float("nan"), 0.0, 0.0)
+
+
+def test_a_place_is_named_by_its_surest_cue():
+    """A phrase (figure or referent) beats an arrow, which beats no cue at all; names compare canonically."""
+    from abstract_map.clauses import named_by
+
+    sign = parse_cue("$LEFT$ Lion, Bird Aviary\nThe Lion is past the Giraffe", SIGN, kind="sign")
+    assert named_by(sign, "Lion") == "phrase"
+    assert named_by(sign, "Giraffe") == "phrase"
+    assert named_by(sign, "Bird Aviary") == "arrow"
+    assert named_by(sign, "Toilets") == "hierarchy"
+    assert named_by([], "Lion") == "hierarchy"
+    assert named_by(sign, "bird aviary", canonical=str.lower) == "arrow"
+    assert named_by(parse_cue("Kingfisher", SIGN, kind="label"), "Kingfisher") == "hierarchy"  # a label is no cue

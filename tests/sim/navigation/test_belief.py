@@ -79,6 +79,23 @@ def test_goal_spread_grows_with_distance_from_evidence():
     assert near < far
 
 
+def test_goal_spread_is_wider_the_less_surely_the_cues_name_the_goal():
+    """Near evidence the spread is the floor for how the goal is named: a phrase, an arrow, the hierarchy alone;
+    far from it the distance to the evidence rules whatever the naming."""
+    params = BeliefParams()
+    goal, anchors = np.array([1.0, 0.0]), np.array([[0.0, 0.0]])
+    spreads = [goal_sigma(goal, anchors, params, placed_by=kind) for kind in ("phrase", "arrow", "hierarchy")]
+    assert spreads == pytest.approx([np.hypot(f, params.label_offset_m) for f in
+                                     (params.sigma_min_m, params.sigma_min_arrow_m, params.sigma_min_hierarchy_m)])
+    assert spreads[0] < spreads[1] < spreads[2]
+    assert goal_sigma(goal, anchors, params) == spreads[0]
+    far = np.array([100.0, 0.0])
+    assert goal_sigma(far, anchors, params, placed_by="phrase") == goal_sigma(far, anchors, params,
+                                                                              placed_by="hierarchy")
+    with pytest.raises(ValueError, match="placed_by must be one of"):
+        goal_sigma(goal, anchors, params, placed_by="rumour")
+
+
 def test_goal_spread_follows_the_models_own_misses():
     """The spread starts from the guess and moves to the misses' per-axis rms as labels are read."""
     params = BeliefParams()
