@@ -17,19 +17,15 @@ which names areas, and misleading signage, whose turned arrows the navigator mee
 
 from __future__ import annotations
 
-import argparse
 import math
 from collections import Counter, defaultdict
 from collections.abc import Mapping
 
-from tqdm import tqdm
-
 from abstract_map.clauses import Locational
-from abstract_map.errors import AbstractMapError
 from abstract_map.grammar import Anchor, parse_cue
 from abstract_map.hierarchy import Hierarchy
-from sim.experiments.world_spec import parse_world_spec
-from sim.world.data import Tag, World, load_world
+from sim.experiments.survey import buildings, on_world, survey_parser
+from sim.world.data import Tag, World
 from sim.world.generator import generate
 from sim.world.truth import Routes, first_leg, place_tags
 
@@ -98,23 +94,15 @@ def summary(name: str, counts: Counter[tuple[str, bool]]) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("seeds", nargs="*", type=int, help="first and last development seed (default 0 47)")
-    parser.add_argument("--world", help="a world folder or a name under worlds/ instead of generated seeds")
+    parser = survey_parser(__doc__, (0, 47))
     args = parser.parse_args(argv)
     if args.world:
-        try:
-            world = load_world(args.world)
-            counts = route_agreement(world, Hierarchy.from_xml(world.hierarchy_path))
-        except AbstractMapError as error:
-            parser.exit(2, f"area_arrows: {error}\n")
-        print("\n".join(summary(world.name, counts)))
+        counts = on_world(parser, args, "area_arrows",
+                          lambda world: route_agreement(world, Hierarchy.from_xml(world.hierarchy_path)))
+        print("\n".join(summary(args.world, counts)))
         return 0
-    if len(args.seeds) not in (0, 2):
-        parser.error("give FIRST LAST, or no seeds")
-    first, last = args.seeds if args.seeds else (0, 47)
     by_level: dict[str, Counter[tuple[str, bool]]] = defaultdict(Counter)
-    for building in tqdm(parse_world_spec(f"generated:{first}-{last}").generated(), desc="buildings"):
+    for building in buildings(parser, args):
         built = generate(building.seed, style=building.style, signage=building.signage)
         by_level[building.signage] += route_agreement(built.world, built.hierarchy)
     lines = summary("all", sum(by_level.values(), Counter()))

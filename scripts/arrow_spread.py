@@ -14,19 +14,16 @@ and the layout does not depend on the signage).
 
 from __future__ import annotations
 
-import argparse
 import math
 from collections import defaultdict
 from collections.abc import Iterable
 
 import numpy as np
-from tqdm import tqdm
 
 from abstract_map.clauses import Locational
-from abstract_map.errors import AbstractMapError
 from abstract_map.grammar import Anchor, parse_cue
-from sim.experiments.world_spec import parse_world_spec
-from sim.world.data import Tag, World, load_world
+from sim.experiments.survey import buildings, on_world, survey_parser
+from sim.world.data import Tag, World
 from sim.world.generator import generate
 
 
@@ -65,24 +62,14 @@ def world_offsets(world: World) -> list[tuple[float, float]]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("seeds", nargs="*", type=int, help="first and last development seed (default 0 99)")
-    parser.add_argument("--world", help="a world folder or a name under worlds/ instead of generated seeds")
+    parser = survey_parser(__doc__, (0, 99))
     parser.add_argument("--length", type=float, default=8.0, help="m along the arrow a place is put (default 8)")
     args = parser.parse_args(argv)
     if args.world:
-        try:
-            offsets = world_offsets(load_world(args.world))
-        except AbstractMapError as error:
-            parser.exit(2, f"arrow_spread: {error}\n")
-        print(summary(args.world, offsets, args.length))
+        print(summary(args.world, on_world(parser, args, "arrow_spread", world_offsets), args.length))
         return 0
-    if len(args.seeds) not in (0, 2):
-        parser.error("give FIRST LAST, or no seeds")
-    first, last = args.seeds if args.seeds else (0, 99)
     by_style: dict[str, list[tuple[float, float]]] = defaultdict(list)
-    for building in tqdm(parse_world_spec(f"generated:{first}-{last}:signage=complete").generated(),
-                         desc="buildings"):
+    for building in buildings(parser, args, ":signage=complete"):
         by_style[building.style] += world_offsets(generate(building.seed, style=building.style).world)
     print(summary("all", [o for os_ in by_style.values() for o in os_], args.length))
     for style, offsets in sorted(by_style.items()):

@@ -15,22 +15,19 @@ offset from its place (``BeliefParams.label_offset_m``, which ``goal_sigma`` add
 
 from __future__ import annotations
 
-import argparse
 import math
 from collections import defaultdict
 from collections.abc import Iterable
 
 import numpy as np
-from tqdm import tqdm
 
 from abstract_map.clauses import NAMED_BY, named_by
-from abstract_map.errors import AbstractMapError
 from abstract_map.grammar import Anchor, parse_cue
 from abstract_map.hierarchy import Hierarchy
 from abstract_map.model import AbstractMap
-from sim.experiments.world_spec import parse_world_spec
+from sim.experiments.survey import buildings, on_world, survey_parser
 from sim.navigation.belief import BeliefParams
-from sim.world.data import Tag, load_world
+from sim.world.data import Tag
 from sim.world.generator import generate
 
 FOLDS = 4  # a quarter of the places held out at a time: the rest read, as a robot far into a search has
@@ -78,28 +75,19 @@ def summary(name: str, misses: list[tuple[str, float]], label_offset_m: float) -
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("seeds", nargs="*", type=int, help="first and last development seed (default 12 35)")
-    parser.add_argument("--world", help="a world folder or a name under worlds/ instead of generated seeds")
+    parser = survey_parser(__doc__, (12, 35))
     args = parser.parse_args(argv)
-    offset = BeliefParams().label_offset_m
-    rng = np.random.default_rng(0)
+    offset, rng = BeliefParams().label_offset_m, np.random.default_rng(0)
     if args.world:
-        try:
-            world = load_world(args.world)
-            misses = held_out_misses(world.tags.values(), Hierarchy.from_xml(world.hierarchy_path), world.start, rng)
-        except AbstractMapError as error:
-            parser.exit(2, f"placement_by_cue: {error}\n")
-        print("\n".join(summary(world.name, misses, offset)))
+        misses = on_world(parser, args, "placement_by_cue", lambda world: held_out_misses(
+            world.tags.values(), Hierarchy.from_xml(world.hierarchy_path), world.start, rng))
+        print("\n".join(summary(args.world, misses, offset)))
         return 0
-    if len(args.seeds) not in (0, 2):
-        parser.error("give FIRST LAST, or no seeds")
-    first, last = args.seeds if args.seeds else (12, 35)
     misses = []
-    for building in tqdm(parse_world_spec(f"generated:{first}-{last}").generated(), desc="buildings"):
+    for building in buildings(parser, args):
         built = generate(building.seed, style=building.style, signage=building.signage)
         misses += held_out_misses(built.world.tags.values(), built.hierarchy, built.world.start, rng)
-    print("\n".join(summary(f"{first}-{last}", misses, offset)))
+    print("\n".join(summary("all", misses, offset)))
     return 0
 
 
