@@ -109,6 +109,28 @@ def test_family_labels_are_the_goals_siblings_read(tmp_path):
     assert np.isfinite(read).all()
 
 
+def test_the_goal_prior_narrows_as_signs_name_the_goal(tmp_path):
+    """Before any cue the goal is placed by the hierarchy alone; a sign's arrow naming it narrows the prior's floor
+    to the arrows', a phrase naming it to the phrases' (``BeliefParams.floor_m``)."""
+    from sim.experiments.trial import TrialParams, policy_params
+    from sim.navigation.policies import GuidedPolicy
+    from sim.world.data import load_world
+    from sim.world.generator import generated_world
+
+    world = load_world(generated_world(3, style="office", size="small", signage="complete", root=tmp_path))
+    goal = sorted(world.goals)[0]
+    params = policy_params(TrialParams())
+    policy = GuidedPolicy(world, goal, world.start, params)
+    assert policy.placed_by() == "hierarchy"
+    policy.nav.model.observe_tag(9001, f"$UP$ {goal}", world.start, kind="sign")
+    assert policy.placed_by() == "arrow"
+    policy.nav.model.observe_tag(9002, f"The {goal} is near here", world.start, kind="sign")
+    assert policy.placed_by() == "phrase"
+    floors = [params.belief.floor_m(kind) for kind in ("hierarchy", "arrow", "phrase")]
+    assert floors[0] > floors[1] > floors[2] == params.belief.sigma_min_m
+    assert policy.goal_prior().sigma_m >= floors[2]
+
+
 def test_an_arrow_naming_a_sibling_leads_into_the_goals_area(tmp_path):
     """An arrow naming a place of the goal's area counts as the area's arrow (``area_wrong_prob``) unless its
     sign names the goal itself; an arrow naming another area's place does not count. A sign naming a sibling
