@@ -82,7 +82,7 @@ def test_goal_spread_grows_with_distance_from_evidence():
 def test_goal_spread_is_wider_the_less_surely_the_cues_name_the_goal():
     """Near evidence the spread is the floor for how the goal is named: a phrase, an arrow, the hierarchy alone;
     far from it the distance to the evidence rules whatever the naming."""
-    params = BeliefParams()
+    params = BeliefParams(sigma_min_arrow_m=8.4, sigma_min_hierarchy_m=9.9)  # the measured floors (not the defaults)
     goal, anchors = np.array([1.0, 0.0]), np.array([[0.0, 0.0]])
     spreads = [goal_sigma(goal, anchors, params, placed_by=kind) for kind in ("phrase", "arrow", "hierarchy")]
     assert spreads == pytest.approx([np.hypot(f, params.label_offset_m) for f in

@@ -109,8 +109,8 @@ def test_family_labels_are_the_goals_siblings_read(tmp_path):
     assert np.isfinite(read).all()
 
 
-def test_the_goal_prior_narrows_as_signs_name_the_goal(tmp_path):
-    """Before any cue the goal is placed by the hierarchy alone; a sign's arrow naming it narrows the prior's floor
+def test_the_goal_priors_floor_follows_how_signs_name_the_goal(tmp_path):
+    """Before any cue the goal is placed by the hierarchy alone; a sign's arrow naming it takes the prior's floor
     to the arrows', a phrase naming it to the phrases' (``BeliefParams.floor_m``)."""
     from sim.experiments.trial import TrialParams, policy_params
     from sim.navigation.policies import GuidedPolicy
@@ -126,9 +126,10 @@ def test_the_goal_prior_narrows_as_signs_name_the_goal(tmp_path):
     assert policy.placed_by() == "arrow"
     policy.nav.model.observe_tag(9002, f"The {goal} is near here", world.start, kind="sign")
     assert policy.placed_by() == "phrase"
-    floors = [params.belief.floor_m(kind) for kind in ("hierarchy", "arrow", "phrase")]
-    assert floors[0] > floors[1] > floors[2] == params.belief.sigma_min_m
-    assert policy.goal_prior().sigma_m >= floors[2]
+    belief = params.belief
+    assert [belief.floor_m(k) for k in ("hierarchy", "arrow", "phrase")] == [
+        belief.sigma_min_hierarchy_m, belief.sigma_min_arrow_m, belief.sigma_min_m]
+    assert policy.goal_prior().sigma_m >= belief.sigma_min_m
 
 
 def test_an_arrow_naming_a_sibling_leads_into_the_goals_area(tmp_path):
