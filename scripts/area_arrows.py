@@ -22,7 +22,6 @@ from collections import Counter, defaultdict
 from collections.abc import Mapping
 
 from abstract_map.clauses import Locational
-from abstract_map.grammar import Anchor, parse_cue
 from abstract_map.hierarchy import Hierarchy
 from sim.experiments.survey import buildings, on_world, survey_parser
 from sim.world.data import Tag, World
@@ -60,8 +59,7 @@ def route_agreement(world: World, hierarchy: Hierarchy) -> Counter[tuple[str, bo
             labels[tag.text].append(tag)
     out: Counter[tuple[str, bool]] = Counter()
     for sign in (t for t in world.tags.values() if t.kind == "sign"):
-        arrows = [c for c in parse_cue(sign.text, Anchor(f"#{sign.id}", sign.x, sign.y, sign.theta), kind="sign")
-                  if isinstance(c, Locational) and c.kind == "arrow"]
+        arrows = [c for c in sign.clauses() if isinstance(c, Locational) and c.kind == "arrow"]
         pose = routes.reading_pose(sign)
         field_ = None if pose is None else routes.field_from(pose)
         if field_ is None:

@@ -21,7 +21,6 @@ from collections.abc import Iterable
 import numpy as np
 
 from abstract_map.clauses import Locational
-from abstract_map.grammar import Anchor, parse_cue
 from sim.experiments.survey import buildings, on_world, survey_parser
 from sim.world.data import Tag, World
 from sim.world.generator import generate
@@ -34,7 +33,7 @@ def arrow_offsets(tags: Iterable[Tag]) -> list[tuple[float, float]]:
     labels = {t.text.casefold(): t for t in tags if t.kind == "label"}
     out = []
     for sign in (t for t in tags if t.kind == "sign"):
-        for clause in parse_cue(sign.text, Anchor(f"#{sign.id}", sign.x, sign.y, sign.theta), kind="sign"):
+        for clause in sign.clauses():
             if not isinstance(clause, Locational) or clause.kind != "arrow":
                 continue
             label = labels.get(clause.toponym.casefold())

@@ -22,7 +22,6 @@ from collections.abc import Iterable
 import numpy as np
 
 from abstract_map.clauses import NAMED_BY, named_by
-from abstract_map.grammar import Anchor, parse_cue
 from abstract_map.hierarchy import Hierarchy
 from abstract_map.model import AbstractMap
 from sim.experiments.survey import buildings, on_world, survey_parser
@@ -42,8 +41,7 @@ def held_out_misses(tags: Iterable[Tag], hierarchy: Hierarchy, start: tuple[floa
     for tag in tags:
         if tag.kind == "label":
             labels[tag.text].append(tag)
-    clauses = [c for t in tags if t.kind == "sign"
-               for c in parse_cue(t.text, Anchor(f"#{t.id}", t.x, t.y, t.theta), kind="sign")]
+    clauses = [c for t in tags if t.kind == "sign" for c in t.clauses()]
     places = sorted(labels)
     rng.shuffle(places)
     out = []

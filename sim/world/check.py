@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from abstract_map.clauses import Locational, Relational
-from abstract_map.grammar import Anchor, CueError, parse_cue
+from abstract_map.grammar import CueError
 from abstract_map.hierarchy import Hierarchy, HierarchyError
 from sim.world.data import Tag, World
 from sim.world.oracle import oracle_paths
@@ -121,7 +121,7 @@ def check_world(world: World, *, hierarchy: Hierarchy | None = None, params: Tru
         if tag.kind == "empty":
             continue
         try:
-            clauses[tag.id] = parse_cue(tag.text, Anchor(f"#{tag.id}", tag.x, tag.y, tag.theta), kind=tag.kind)
+            clauses[tag.id] = tag.clauses()
         except CueError as exc:
             report.add("grammar", subject, str(exc))
             continue

@@ -24,7 +24,9 @@ from typing import Any
 import numpy as np
 
 from abstract_map import errors
+from abstract_map.clauses import Clause, tag_anchor
 from abstract_map.errors import AbstractMapError, one_line
+from abstract_map.grammar import Anchor, parse_cue
 from abstract_map.hierarchy import Hierarchy
 
 FORMAT = "abstract-map-world/1"
@@ -122,6 +124,11 @@ class Tag:
     theta: float  # rad, direction the tag's face points
     kind: str  # "label" (marks a place behind it), "sign" (cue text) or "empty"
     text: str  # lines separated by "\n"
+
+    def clauses(self) -> list[Clause]:
+        """What the tag says as clauses of the grammar, anchored at its own pose (anchor ``#<id>``); raises
+        :class:`abstract_map.grammar.CueError` for text the grammar does not read."""
+        return parse_cue(self.text, Anchor(tag_anchor(self.id), self.x, self.y, self.theta), kind=self.kind)
 
     def to_dict(self) -> dict[str, Any]:
         return {"id": self.id, "x_m": self.x, "y_m": self.y,
