@@ -11,7 +11,10 @@ signage level, style, ...):
 - the mean SPL of each and the mean change per trial with its standard error
   (the sample standard deviation of the changes over the square root of their
   number): a change under two standard errors is within the spread;
-- the geometric mean ratio of the walks found by both (new over base);
+- the geometric mean ratio of the walks found by both (new over base), and how
+  many paired walks went the same way (found alike, within ``SAME_WALK_M``): a
+  change of code that moves few walks is resolved by fewer trials than one
+  that moves them all;
 - where the found walks went (:data:`sim.experiments.walk.PHASES`, mean metres
   per found trial), when the records carry the walk's marks.
 
@@ -36,6 +39,7 @@ Record = dict[str, Any]
 Key = tuple[Any, ...]
 PAIR_FIELDS = ("world", "goal", "seed", "perception")  # what makes two trials the same trial
 GROUPS = ("signage", "style")  # the default groups after "all"
+SAME_WALK_M = 0.01  # m; two paired walks this close in length, found alike, went the same way
 
 
 class CompareError(ValueError):
@@ -55,6 +59,7 @@ class Row:
     change: float  # mean SPL change per trial, new - base
     change_se: float  # its standard error (nan for one trial)
     walk_ratio: float | None  # geometric mean of new / base walks found by both (None: none found by both)
+    same: int  # paired walks that went the same way: found alike, lengths within SAME_WALK_M
     phases_base: tuple[float, ...] | None  # mean m per found trial, by PHASES (None: no marks)
     phases_new: tuple[float, ...] | None
 
@@ -140,8 +145,10 @@ def _row(group: str, pairs: list[tuple[Record, Record]]) -> Row:
     both = [(float(b["distance_m"]), float(n["distance_m"])) for b, n in pairs
             if b["success"] and n["success"] and float(b["distance_m"]) > 0 and float(n["distance_m"]) > 0]
     ratio = float(np.exp(np.mean([math.log(n / b) for b, n in both]))) if both else None
+    same = sum(bool(b["success"]) == bool(n["success"])
+               and abs(float(b["distance_m"]) - float(n["distance_m"])) <= SAME_WALK_M for b, n in pairs)
     return Row(group, len(pairs), sum(bool(b["success"]) for b, _ in pairs), sum(bool(n["success"]) for _, n in pairs),
-               float(spl_b.mean()), float(spl_n.mean()), float(diff.mean()), se, ratio,
+               float(spl_b.mean()), float(spl_n.mean()), float(diff.mean()), se, ratio, same,
                _phase_means([b for b, _ in pairs]), _phase_means([n for _, n in pairs]))
 
 
@@ -156,15 +163,16 @@ def markdown(result: Comparison, base_name: str, new_name: str) -> str:
     left unpaired."""
     lines = [f"# {new_name} against {base_name}, trial by trial", "",
              "| group | trials | found, base | found, new | SPL, base | SPL, new | change of SPL "
-             "| walks found by both |",
-             "|---|---|---|---|---|---|---|---|"]
+             "| walks found by both | walks the same |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for r in result.rows:
         se = "" if math.isnan(r.change_se) else f" ± {r.change_se:.3f}"
         walks = "" if r.walk_ratio is None else f"x {r.walk_ratio:.3f}"
         lines.append(f"| {r.group} | {r.trials} | {r.found_base} | {r.found_new} | {r.spl_base:.3f} | "
-                     f"{r.spl_new:.3f} | {r.change:+.3f}{se} | {walks} |")
+                     f"{r.spl_new:.3f} | {r.change:+.3f}{se} | {walks} | {r.same} |")
     lines += ["", "Change of SPL: mean per trial, new - base, with its standard error; walks found by both: the "
-              "geometric mean ratio new / base."]
+              f"geometric mean ratio new / base; walks the same: found alike and within {SAME_WALK_M:g} m in length "
+              "(the walks the change did not move)."]
     top = result.rows[0]
     if top.phases_base is not None and top.phases_new is not None:
         lines += ["", "Where the found walks went (mean m per found trial):", "",

@@ -13,6 +13,7 @@ import math
 import re
 from collections import Counter
 from collections.abc import Callable, Iterable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -57,6 +58,48 @@ def stats(records: list[Record]) -> dict[str, Any]:
             "wall": float(np.mean(walls)) if walls else math.nan,
             "cpu": float(np.mean(cpus)) if cpus else math.nan,
             "failures": Counter(reason_kind(r) for r in records if not r["success"])}
+
+
+@dataclass(frozen=True)
+class SeedSpread:
+    """How much one navigator's walks depend on the trial's seed alone (start jitter, detection noise)."""
+
+    goals: int  # goals (world, goal, perception) run with two seeds or more
+    sd: float  # SPL; the pooled standard deviation of one goal's SPL across its seeds
+    apart: float  # share of the pairs of seeds of one goal whose SPL differ by more than APART_SPL
+    same: float  # share of those pairs that walked the same (SPL within SAME_SPL)
+
+    @property
+    def trials_needed(self) -> int:
+        """Paired trials for a change of ``RESOLVE_SPL`` to stand at two standard errors, if the change draws
+        every walk afresh as a new seed does (a change that moves fewer walks needs fewer)."""
+        return math.ceil((2 * math.sqrt(2) * self.sd / RESOLVE_SPL) ** 2)
+
+
+APART_SPL = 0.1  # SPL; two seeds' walks this far apart took different ways
+SAME_SPL = 0.005  # SPL; two seeds' walks this close are the same walk
+RESOLVE_SPL = 0.01  # SPL; the change a comparison is asked to resolve (screens gain 0.005-0.02)
+
+
+def seed_spread(records: list[Record]) -> dict[str, SeedSpread]:
+    """Per navigator, over the goals run with two seeds or more: the pooled standard deviation of a goal's SPL
+    across seeds and how often two seeds' walks part (:class:`SeedSpread`); navigators with no such goal are
+    left out."""
+    runs: dict[tuple[str, ...], list[float]] = {}
+    for r in records:
+        if r.get("spl") is not None:
+            key = (r.get("navigator", "paper"), str(r.get("world", "")), r["goal"], str(r.get("perception", "")))
+            runs.setdefault(key, []).append(float(r["spl"]))
+    out: dict[str, SeedSpread] = {}
+    for nav in dict.fromkeys(key[0] for key in runs):
+        groups = [np.array(v) for key, v in runs.items() if key[0] == nav and len(v) >= 2]
+        if not groups:
+            continue
+        squares = sum(float(np.sum((g - g.mean()) ** 2)) for g in groups)
+        sd = math.sqrt(squares / sum(len(g) - 1 for g in groups))
+        gaps = np.concatenate([np.abs(g[:, None] - g[None, :])[np.triu_indices(len(g), 1)] for g in groups])
+        out[nav] = SeedSpread(len(groups), sd, float(np.mean(gaps > APART_SPL)), float(np.mean(gaps <= SAME_SPL)))
+    return out
 
 
 def _f(value: float, spec: str = ".2f") -> str:
@@ -167,7 +210,8 @@ def worst_pictures(worst: list[Record], worlds: dict[str, World], folder: Path) 
 
 def summary_markdown(records: list[Record], *, worst: list[Record], pictures: Iterable[Path | None],
                      relative_to: Path) -> str:
-    """The sections over all trials: overall, by style and signage, failures, per world, the ten worst."""
+    """The sections over all trials: overall, by style and signage, failures, where the walking went, how much
+    a walk depends on its seed, per world, the ten worst."""
     nav = lambda r: r.get("navigator", "paper")  # noqa: E731
     generated = any(r.get("style") for r in records)
     lines = ["## Over all trials", "",
@@ -204,6 +248,18 @@ def summary_markdown(records: list[Record], *, worst: list[Record], pictures: It
                   "few are a search that came close and turned away.", "",
                   "| " + " | ".join(walk_header) + " |", "|" + " --- |" * len(walk_header),
                   *["| " + " | ".join(row) + " |" for row in walks]]
+    spread = seed_spread(records)
+    if spread:
+        lines += ["", "### How much a walk depends on its seed", "",
+                  "Over the goals run with two seeds or more, which differ only by the start's jitter and the "
+                  "detection noise: the standard deviation of one goal's SPL across its seeds, the share of pairs "
+                  f"of seeds whose SPL differ by more than {APART_SPL:g} and that walk the same (within "
+                  f"{SAME_SPL:g}), and the paired trials a change of {RESOLVE_SPL:g} SPL needs to stand at two "
+                  "standard errors if it draws every walk afresh as a new seed does.", "",
+                  "| navigator | goals | SPL sd across seeds | pairs apart | pairs the same | trials needed |",
+                  "| --- | --- | --- | --- | --- | --- |"]
+        lines += [f"| {nav} | {s.goals} | {s.sd:.3f} | {s.apart:.0%} | {s.same:.0%} | {s.trials_needed} |"
+                  for nav, s in spread.items()]
     lines += ["", "### Per world", ""]
     lines += grouped_table(records, ["world", "style", "signage", "navigator"],
                            lambda r: (r.get("world", ""), r.get("style") or "-", r.get("signage") or "-", nav(r)))

@@ -41,6 +41,7 @@ def test_paired_change_and_its_standard_error(tmp_path):
     assert rows["all"].change == pytest.approx(mean) and rows["all"].change_se == pytest.approx(se)
     assert rows["all"].spl_base == pytest.approx(0.3) and rows["all"].spl_new == pytest.approx(0.4)
     assert rows["all"].walk_ratio == pytest.approx(math.sqrt(30 / 40 * 50 / 50))  # found by both: A and B
+    assert rows["all"].same == 1 and rows["signage=sparse"].same == 0  # B walked alike; C was found by new alone
     assert rows["signage=sparse"].trials == 1 and math.isnan(rows["signage=sparse"].change_se)
     assert rows["signage=sparse"].walk_ratio is None
 
@@ -107,6 +108,7 @@ def test_command_prints_the_table_and_writes_it(tmp_path, capsys):
     assert main(["compare", str(base), str(new), "--by", "none", "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "| all | 2 | 2 | 2 | 0.450 | 0.550 | +0.100 ± 0.000 |" in printed
+    assert "| walks found by both | walks the same |" in printed
     assert out.read_text() == printed
 
 

@@ -249,6 +249,29 @@ def test_summary_groups_scores_and_lists_the_worst(tmp_path):
     assert "| paper | 100% (2/2) | 0.88 | 1.17 |" in text
 
 
+def test_seed_spread_pools_each_goals_spread_across_its_seeds():
+    from sim.experiments.summary import seed_spread, summary_markdown
+
+    def record(goal: str, seed: int, spl: float, navigator: str = "guided") -> dict:
+        return {"world": "a", "navigator": navigator, "perception": "geometric", "goal": goal, "seed": seed,
+                "success": spl > 0, "distance_m": 30.0, "oracle_m": 30.0, "spl": spl, "wall_s": 1.0,
+                "reason": "goal label read"}
+
+    # X: seeds 0.5, 0.7, 0.9 (squares 0.08, 2 degrees of freedom); Y: 0.4 twice (0, 1): sd sqrt(0.08 / 3)
+    records = [record("X", 0, 0.5), record("X", 1, 0.7), record("X", 2, 0.9), record("Y", 0, 0.4),
+               record("Y", 1, 0.4), record("Z", 0, 0.1, "paper")]
+    spread = seed_spread(records)
+    assert set(spread) == {"guided"}  # paper ran each goal once: no spread to tell
+    s = spread["guided"]
+    assert s.goals == 2 and s.sd == pytest.approx(math.sqrt(0.08 / 3))
+    assert s.apart == pytest.approx(3 / 4) and s.same == pytest.approx(1 / 4)  # X's three pairs apart, Y's same
+    assert s.trials_needed == math.ceil(8 * (0.08 / 3) / 0.01 ** 2)
+    text = summary_markdown(records, worst=[], pictures=[], relative_to=Path("."))
+    assert "### How much a walk depends on its seed" in text
+    assert f"| guided | 2 | 0.163 | 75% | 25% | {s.trials_needed} |" in text
+    assert "How much a walk" not in summary_markdown(records[:1], worst=[], pictures=[], relative_to=Path("."))
+
+
 def test_plan_goes_round_robin_over_worlds(tiny_world, tmp_path):
     from sim.experiments.study_run import plan_study
     from sim.world.data import load_world
