@@ -11,9 +11,9 @@ then be one folder) and prints a Markdown report: per group (all, then each
 value of each --by field), the trials found by each side, the mean SPL of each,
 the mean change per trial with its standard error (a change under two standard
 errors is within the spread of single trials), the geometric mean ratio of
-the walks found by both, and how many walks went the same way; then where the found walks went (far, near but
-unseen, seen but unread: mean metres per found trial) and the trials that only
-one side ran. --out also writes the report to a file. Exit code 2 on bad input
+the walks found by both and how many walks went the same way; then where the
+found walks went (far, near but unseen, seen but unread: mean metres per found
+trial) and the trials that only one side ran. --out also writes the report to a file. Exit code 2 on bad input
 (a missing folder, unreadable records, no shared trial).
 """
 

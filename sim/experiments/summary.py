@@ -9,6 +9,7 @@ trials (lowest SPL, then longest) get a picture of their path.
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from collections import Counter
@@ -67,7 +68,8 @@ class SeedSpread:
     goals: int  # goals (world, goal, perception) run with two seeds or more
     sd: float  # SPL; the pooled standard deviation of one goal's SPL across its seeds
     apart: float  # share of the pairs of seeds of one goal whose SPL differ by more than APART_SPL
-    same: float  # share of those pairs that walked the same (SPL within SAME_SPL)
+    alike: float  # share of those pairs that scored alike (SPL within ALIKE_SPL): the same way, give or take
+    # the start's jitter (two seeds' walks never match to the centimetre)
 
     @property
     def trials_needed(self) -> int:
@@ -77,7 +79,7 @@ class SeedSpread:
 
 
 APART_SPL = 0.1  # SPL; two seeds' walks this far apart took different ways
-SAME_SPL = 0.005  # SPL; two seeds' walks this close are the same walk
+ALIKE_SPL = 0.005  # SPL; two seeds' walks this close took the same way (0.5 % of the walk)
 RESOLVE_SPL = 0.01  # SPL; the change a comparison is asked to resolve (screens gain 0.005-0.02)
 
 
@@ -92,13 +94,12 @@ def seed_spread(records: list[Record]) -> dict[str, SeedSpread]:
             runs.setdefault(key, []).append(float(r["spl"]))
     out: dict[str, SeedSpread] = {}
     for nav in dict.fromkeys(key[0] for key in runs):
-        groups = [np.array(v) for key, v in runs.items() if key[0] == nav and len(v) >= 2]
-        if not groups:
+        goals = [np.array(spls) for key, spls in runs.items() if key[0] == nav and len(spls) >= 2]
+        if not goals:
             continue
-        squares = sum(float(np.sum((g - g.mean()) ** 2)) for g in groups)
-        sd = math.sqrt(squares / sum(len(g) - 1 for g in groups))
-        gaps = np.concatenate([np.abs(g[:, None] - g[None, :])[np.triu_indices(len(g), 1)] for g in groups])
-        out[nav] = SeedSpread(len(groups), sd, float(np.mean(gaps > APART_SPL)), float(np.mean(gaps <= SAME_SPL)))
+        sd = math.sqrt(sum(float(np.sum((g - g.mean()) ** 2)) for g in goals) / sum(len(g) - 1 for g in goals))
+        gaps = np.array([abs(a - b) for g in goals for a, b in itertools.combinations(g, 2)])
+        out[nav] = SeedSpread(len(goals), sd, float(np.mean(gaps > APART_SPL)), float(np.mean(gaps <= ALIKE_SPL)))
     return out
 
 
@@ -253,12 +254,12 @@ def summary_markdown(records: list[Record], *, worst: list[Record], pictures: It
         lines += ["", "### How much a walk depends on its seed", "",
                   "Over the goals run with two seeds or more, which differ only by the start's jitter and the "
                   "detection noise: the standard deviation of one goal's SPL across its seeds, the share of pairs "
-                  f"of seeds whose SPL differ by more than {APART_SPL:g} and that walk the same (within "
-                  f"{SAME_SPL:g}), and the paired trials a change of {RESOLVE_SPL:g} SPL needs to stand at two "
+                  f"of seeds whose SPL differ by more than {APART_SPL:g} and that score alike (within "
+                  f"{ALIKE_SPL:g}), and the paired trials a change of {RESOLVE_SPL:g} SPL needs to stand at two "
                   "standard errors if it draws every walk afresh as a new seed does.", "",
-                  "| navigator | goals | SPL sd across seeds | pairs apart | pairs the same | trials needed |",
+                  "| navigator | goals | SPL sd across seeds | pairs apart | pairs alike | trials needed |",
                   "| --- | --- | --- | --- | --- | --- |"]
-        lines += [f"| {nav} | {s.goals} | {s.sd:.3f} | {s.apart:.0%} | {s.same:.0%} | {s.trials_needed} |"
+        lines += [f"| {nav} | {s.goals} | {s.sd:.3f} | {s.apart:.0%} | {s.alike:.0%} | {s.trials_needed} |"
                   for nav, s in spread.items()]
     lines += ["", "### Per world", ""]
     lines += grouped_table(records, ["world", "style", "signage", "navigator"],

@@ -254,7 +254,7 @@ def test_seed_spread_pools_each_goals_spread_across_its_seeds():
 
     def record(goal: str, seed: int, spl: float, navigator: str = "guided") -> dict:
         return {"world": "a", "navigator": navigator, "perception": "geometric", "goal": goal, "seed": seed,
-                "success": spl > 0, "distance_m": 30.0, "oracle_m": 30.0, "spl": spl, "wall_s": 1.0,
+                "success": spl > 0, "distance_m": 30.0 / spl, "oracle_m": 30.0, "spl": spl, "wall_s": 1.0,
                 "reason": "goal label read"}
 
     # X: seeds 0.5, 0.7, 0.9 (squares 0.08, 2 degrees of freedom); Y: 0.4 twice (0, 1): sd sqrt(0.08 / 3)
@@ -264,7 +264,7 @@ def test_seed_spread_pools_each_goals_spread_across_its_seeds():
     assert set(spread) == {"guided"}  # paper ran each goal once: no spread to tell
     s = spread["guided"]
     assert s.goals == 2 and s.sd == pytest.approx(math.sqrt(0.08 / 3))
-    assert s.apart == pytest.approx(3 / 4) and s.same == pytest.approx(1 / 4)  # X's three pairs apart, Y's same
+    assert s.apart == pytest.approx(3 / 4) and s.alike == pytest.approx(1 / 4)  # X's three pairs apart, Y's alike
     assert s.trials_needed == math.ceil(8 * (0.08 / 3) / 0.01 ** 2)
     text = summary_markdown(records, worst=[], pictures=[], relative_to=Path("."))
     assert "### How much a walk depends on its seed" in text
