@@ -63,7 +63,8 @@ def stats(records: list[Record]) -> dict[str, Any]:
 
 @dataclass(frozen=True)
 class SeedSpread:
-    """How much one navigator's walks depend on the trial's seed alone (start jitter, detection noise)."""
+    """How much one navigator's walks depend on the trial's seed alone (the start's jitter, the stuck recovery's
+    turning direction and, in geometric mode, the detection noise)."""
 
     goals: int  # goals (world, goal, perception) run with two seeds or more
     sd: float  # SPL; the pooled standard deviation of one goal's SPL across its seeds
@@ -252,8 +253,9 @@ def summary_markdown(records: list[Record], *, worst: list[Record], pictures: It
     spread = seed_spread(records)
     if spread:
         lines += ["", "### How much a walk depends on its seed", "",
-                  "Over the goals run with two seeds or more, which differ only by the start's jitter and the "
-                  "detection noise: the standard deviation of one goal's SPL across its seeds, the share of pairs "
+                  "Over the goals run with two seeds or more, which differ only by the seed (the start's jitter, "
+                  "the stuck recovery's turning direction and, in geometric mode, the detection noise): the "
+                  "standard deviation of one goal's SPL across its seeds, the share of pairs "
                   f"of seeds whose SPL differ by more than {APART_SPL:g} and that score alike (within "
                   f"{ALIKE_SPL:g}), and the paired trials a change of {RESOLVE_SPL:g} SPL needs to stand at two "
                   "standard errors if it draws every walk afresh as a new seed does.", "",
