@@ -118,8 +118,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--stride", type=float, default=5.0, help="m walked between samples (default 5)")
     parser.add_argument("--max-sim-s", type=float, default=600.0, help="each walk's cap, s (default 600)")
     args = parser.parse_args(argv)
-    if args.stride <= 0 or args.max_sim_s <= 0:
-        parser.error("--stride and --max-sim-s must be positive")
+    if not (args.stride > 0 and args.max_sim_s > 0):
+        parser.exit(2, f"imagined_goal_worth: --stride and --max-sim-s must be positive metres and seconds, "
+                       f"got {args.stride:g} and {args.max_sim_s:g}\n")
     rng = np.random.default_rng(0)
     if args.world:
         samples = on_world(parser, args, "imagined_goal_worth", lambda world: world_samples(

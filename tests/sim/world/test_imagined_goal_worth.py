@@ -57,3 +57,8 @@ def test_on_the_zoo_the_arrows_put_the_toilets_within_metres_of_their_label():
 def test_a_world_that_is_not_there_is_one_line_and_exit_2(capsys, tmp_path):
     assert "nowhere" in refused_in_one_line(load().main, ["--world", str(tmp_path / "nowhere")], capsys,
                                             "imagined_goal_worth")
+
+
+def test_a_stride_that_is_not_positive_is_one_line_and_exit_2(capsys):
+    assert "got 0 and 600" in refused_in_one_line(load().main, ["--world", "zoo", "--stride", "0"], capsys,
+                                                  "imagined_goal_worth")
