@@ -52,11 +52,7 @@ def free_points(world: World, n: int, rng: np.random.Generator) -> np.ndarray:
     """(n, 2) m: points drawn evenly over the free cells of ``world``'s floor plan (cell centres, world frame)."""
     plan = world.floorplan
     free = np.argwhere(~plan.occupied)
-    cells = free[rng.integers(0, len(free), n)]
-    rows = plan.occupied.shape[0]
-    x = plan.origin[0] + (cells[:, 1] + 0.5) * plan.resolution
-    y = plan.origin[1] + (rows - cells[:, 0] - 0.5) * plan.resolution
-    return np.stack([x, y], axis=1)
+    return plan.pixel_to_world(free[rng.integers(0, len(free), n)])
 
 
 def even_distance(labels_xy: np.ndarray, points_xy: np.ndarray) -> float:
