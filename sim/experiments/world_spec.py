@@ -6,8 +6,10 @@ Forms (``--world`` may be given several times; a study runs over all of them):
 - ``generated:1000-1049``: generated buildings, seeds 1000 to 1049 inclusive
   (``generated:7`` is one seed). Size is medium unless given. Style and signage
   level cycle with the seed over the generator's registries, style fastest:
-  seed ``s`` is style ``STYLES[s % 4]`` and signage ``SIGNAGE[(s // 4) % 3]``,
-  so any 12 consecutive seeds cover every style and signage level together.
+  seed ``s`` is style ``SEED_CYCLE[s % 4]`` (office, hospital, museum, campus)
+  and signage ``SIGNAGE[(s // 4) % 3]``, so any 12 consecutive seeds cover
+  every cycled style and signage level together. A style outside the cycle
+  (``park``) is built only when named.
   Fixing one of them (``style=...`` or ``signage=...``) cycles only the other
   (by ``s % len``).
 - ``generated:1000-1009:style=hospital,signage=sparse,size=small``: fixed
@@ -63,9 +65,9 @@ class WorldSpec:
         """The buildings of a ``generated:`` spec, in seed order (empty for a named world)."""
         if self.seeds is None:
             return []
-        from sim.world.styles import SIGNAGE, STYLES
+        from sim.world.styles import SEED_CYCLE, SIGNAGE
 
-        styles, levels = list(STYLES), list(SIGNAGE)
+        styles, levels = list(SEED_CYCLE), list(SIGNAGE)
         out = []
         for seed in range(self.seeds[0], self.seeds[1] + 1):
             style = self.style or styles[seed % len(styles)]

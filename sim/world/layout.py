@@ -39,6 +39,9 @@ LABEL_OFFSET_M = 0.85  # m, door centre to label centre along the wall (half a d
 TAG_FRONT_M = 0.02  # m, a tag's centre in front of its wall face (the scene's gap: it hangs where it is drawn)
 HALL_STRIP_M = 4.6  # m, depth of the row of rooms along a hall
 MIN_HALL_SIDE_M = 11.0  # m, a hall block this big on both sides gets a row of rooms
+MIN_BLOCK_M = 4.0  # m, the narrowest block two corridors may leave between their lattice lines (a 2.6 m room,
+# its walls and a margin); only the park's wide paths in a small building reach it, so no other style's
+# buildings change
 
 Node = tuple[int, int]
 Edge = tuple[Node, Node]
@@ -418,7 +421,8 @@ def build_layout(style: Style, size: Size, rng: np.random.Generator) -> Layout:
     """The plan of one building (module docstring). Names of areas are assigned here; wings by the caller."""
     nx_, ny = size.cells
     xs, ys = _lines(rng, nx_, size.cell_m), _lines(rng, ny, size.cell_m)
-    lo, hi = style.corridor_m
+    hi = min(style.corridor_m[1], size.cell_m[0] - MIN_BLOCK_M)  # a wide path leaves a block between its lines
+    lo = min(style.corridor_m[0], hi)
 
     def width() -> float:
         return min(hi, max(lo, snap(rng.uniform(lo, hi), 0.2)))

@@ -230,6 +230,8 @@ class Writer:
 
     def _try_row(self, row: str, nearby: list[str], anchor: str) -> str | None:
         n_refs = 2 if row == "between" else 1
+        if len(nearby) < 1 + n_refs:  # "between" needs three places near the sign
+            return None
         for _ in range(40):
             pick = [nearby[k] for k in self.rng.choice(len(nearby), size=1 + n_refs, replace=False)]
             fig, refs = pick[0], tuple(pick[1:])

@@ -6,7 +6,7 @@ import pytest
 
 from abstract_map.cli import main
 from sim.experiments.world_spec import WorldSpecError, parse_world_spec, resolve_worlds, seed_split
-from sim.world.styles import SIGNAGE, STYLES
+from sim.world.styles import SEED_CYCLE, SIGNAGE, STYLES
 
 
 def test_a_name_or_folder_is_kept_as_given():
@@ -18,9 +18,18 @@ def test_a_range_cycles_style_and_signage_so_twelve_seeds_cover_every_pair():
     spec = parse_world_spec("generated:1000-1011")
     built = spec.generated()
     assert [g.seed for g in built] == list(range(1000, 1012))
-    assert {(g.style, g.signage) for g in built} == {(s, level) for s in STYLES for level in SIGNAGE}
+    assert {(g.style, g.signage) for g in built} == {(s, level) for s in SEED_CYCLE for level in SIGNAGE}
     assert all(g.size == "medium" for g in built)
-    assert built[0].style == list(STYLES)[1000 % len(STYLES)]
+    assert built[0].style == SEED_CYCLE[1000 % len(SEED_CYCLE)]
+
+
+def test_the_seed_cycle_is_the_one_the_test_split_was_fixed_with_and_park_is_built_only_by_name():
+    assert SEED_CYCLE == ("office", "hospital", "museum", "campus")  # every numbered building's style
+    assert set(STYLES) - set(SEED_CYCLE) == {"park"}
+    assert "park" not in {g.style for g in parse_world_spec("generated:0-99").generated()}
+    named = parse_world_spec("generated:4-6:style=park").generated()
+    assert [(g.seed, g.style) for g in named] == [(4, "park"), (5, "park"), (6, "park")]
+    assert {g.signage for g in named} == set(SIGNAGE)
 
 
 def test_fixed_options_and_the_other_cycles():

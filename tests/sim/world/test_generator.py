@@ -124,6 +124,35 @@ def test_signage_levels_share_the_building():
     assert report.ok and {(int(f.subject.split()[1])) for f in declared} == {m["tag"] for m in misleading.misleading}
 
 
+def arrow_offsets_deg(g) -> list[float]:
+    """Per arrow, degrees between its direction and the bearing from its sign to the nearest label of its place."""
+    from sim.world.truth import place_tags
+
+    out = []
+    for tag, clause in arrows_and_phrases(g.world):
+        if isinstance(clause, Locational) and clause.kind == "arrow":
+            label = min(place_tags(clause.toponym, g.hierarchy, g.world.tags),
+                        key=lambda t: math.hypot(t.x - tag.x, t.y - tag.y))
+            off = math.atan2(label.y - tag.y, label.x - tag.x) - clause.direction
+            out.append(math.degrees(abs((off + math.pi) % (2 * math.pi) - math.pi)))
+    return out
+
+
+def test_the_park_is_open_ground_and_its_arrows_point_nearer_their_places():
+    """The park keeps every path, so each block of rooms is an island in open ground, and from there an
+    arrow's place lies within 45 degrees of it more often than in an office (development seeds 0-11 measured
+    70 % against 53 %; the zoo's signs 96 %)."""
+    within = {}
+    for style in ("park", "office"):
+        offsets = [o for seed in range(4) for o in arrow_offsets_deg(made(seed, style, "medium"))]
+        within[style] = float(np.mean(np.array(offsets) <= 45.0))
+    assert within["park"] > within["office"] + 0.1
+    park, office = made(0, "park", "medium"), made(0, "office", "medium")
+    cx, cy = len(park.layout.xs) - 1, len(park.layout.ys) - 1  # blocks across and up
+    assert park.layout.graph.number_of_edges() == (cx - 1) * cy + (cy - 1) * cx  # no path cut
+    assert not park.layout.halls and (park.layout.raster() > 0).mean() > (office.layout.raster() > 0).mean()
+
+
 def test_every_junction_sign_is_read_from_its_junction():
     """A junction's sign hangs where the junction's centre sees its reader, never in a room behind its wall
     (office seed 3 once hung one south of a T's crossing wall, read only from the room below)."""
