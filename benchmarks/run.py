@@ -274,6 +274,13 @@ class GeneraliseSuite:
     # and a point-goal planner told that and its facing (what the building costs a navigator told the goal)
     camera: tuple[str, ...] = ("guided",)  # ours, to compare camera with geometric on the same trials
     max_sim_s: float = 600.0  # s of simulated time per trial: 4.8x the longest oracle's drive at full speed
+    style: str | None = None  # None: styles cycle with the seed (the test split); a name fixes every building's,
+    # e.g. "park", which is outside the cycle
+
+    def worlds(self, count: int) -> str:
+        """The ``--world`` spec of the first ``count`` test buildings."""
+        spec = f"generated:{TEST_SEED}-{TEST_SEED + count - 1}"
+        return f"{spec}:style={self.style}" if self.style else spec
 
 
 def bench_generalise(suite: GeneraliseSuite = GeneraliseSuite(), workers: int = 2,
@@ -293,7 +300,7 @@ def bench_generalise(suite: GeneraliseSuite = GeneraliseSuite(), workers: int = 
     for perception, count, navigators in parts:
         if count < 1 or not navigators:
             continue
-        settings = StudySettings(worlds=(f"generated:{TEST_SEED}-{TEST_SEED + count - 1}",), perception=perception,
+        settings = StudySettings(worlds=(suite.worlds(count),), perception=perception,
                                  navigators=navigators, trials=1, max_sim_s=suite.max_sim_s)
         bar = tqdm(total=0, unit="trial", desc=perception, file=sys.stderr, dynamic_ncols=True)
 
@@ -307,7 +314,7 @@ def bench_generalise(suite: GeneraliseSuite = GeneraliseSuite(), workers: int = 
         print(f"generalise: {perception} done, {len(outcome.records)} trials, {outcome.wall_s / 60:.1f} min",
               file=sys.stderr, flush=True)
     wall = time.perf_counter() - began
-    generalise_tables(records, f"Generalisation over test buildings {TEST_SEED}-{TEST_SEED + suite.buildings - 1} "
+    generalise_tables(records, f"Generalisation over test buildings {suite.worlds(suite.buildings)} "
                                f"(camera: first {suite.camera_buildings}), 1 trial per goal, cap "
                                f"{suite.max_sim_s:.0f} s, {workers} workers")
     print(f"benchmark wall time: {wall / 60:.1f} min (trials resumed from {out} not counted)")
@@ -377,6 +384,8 @@ def main() -> int:
                         help=f"generalise: of those, how many with the camera (default {suite.camera_buildings})")
     parser.add_argument("--max-sim-s", type=float, default=suite.max_sim_s,
                         help=f"generalise: cap on each trial's simulated seconds (default {suite.max_sim_s:.0f})")
+    parser.add_argument("--style", default=None,
+                        help="generalise: one style for every building, e.g. park (default: styles cycle)")
     parser.add_argument("--workers", type=int, default=2, help="generalise: parallel trials (default 2)")
     parser.add_argument("--out", type=Path, default=ROOT / "runs" / "generalise",
                         help="generalise: study folder, re-used to resume (default runs/generalise)")
@@ -393,10 +402,14 @@ def main() -> int:
             and 1.0 <= args.max_sim_s <= 1e6):
         parser.error("--buildings must be 1-1000, --camera-buildings 0 to --buildings, --workers at least 1, "
                      "--max-sim-s 1 to 1000000")
+    from sim.world.styles import STYLES
+
+    if args.style is not None and args.style not in STYLES:
+        parser.error(f"--style {args.style!r}: expected one of {', '.join(STYLES)}")
     for name in args.which or BENCHMARKS:
         if name == "generalise":
             chosen = replace(suite, buildings=args.buildings, camera_buildings=args.camera_buildings,
-                             max_sim_s=args.max_sim_s)
+                             max_sim_s=args.max_sim_s, style=args.style)
             bench_generalise(chosen, args.workers, args.out, args.report_only)
         elif name == "settle":
             bench_settle(args.against)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import sys
 
+import pytest
+
 from tests.repo_files import load_file
 
 
@@ -33,3 +35,14 @@ def test_a_tiny_generalise_suite_runs_and_tabulates(tmp_path, capsys, monkeypatc
     assert len(records) == 10  # 5 goals x 2 navigators; the frontier's 5 from one shared run
     assert {r["world"] for r in records} == {"gen-office-medium-sparse-1000"}
     assert all(r["sim_s"] <= 10.5 for r in records)
+
+
+def test_a_style_fixes_every_building_and_an_unknown_one_is_refused(monkeypatch, capsys):
+    run = _benchmarks(monkeypatch)
+    assert run.GeneraliseSuite().worlds(30) == "generated:1000-1029"
+    assert run.GeneraliseSuite(style="park").worlds(20) == "generated:1000-1019:style=park"
+    monkeypatch.setattr(sys, "argv", ["run.py", "generalise", "--style", "castle"])
+    with pytest.raises(SystemExit) as exit_:
+        run.main()
+    assert exit_.value.code == 2
+    assert "--style 'castle': expected one of office, hospital, museum, campus, park" in capsys.readouterr().err

@@ -7,10 +7,11 @@ Examples:
   abstract-map study --world zoo --trials 200 --executor ray --address auto --out runs/big
 
 --world (repeatable): a world name under worlds/, a world folder, or generated:A-B[:key=value,...]
-with keys style (office, hospital, museum, campus), size (small, medium, large; default medium) and
-signage (complete, sparse, misleading). Unless fixed, style and signage cycle with the seed: seed s is
-style number s % 4 and signage level number (s // 4) % 3 in those lists, so any 12 consecutive seeds
-cover every pair (with one fixed, the other cycles by s % its count). Generated worlds are written to
+with keys style (office, hospital, museum, campus, park), size (small, medium, large; default medium)
+and signage (complete, sparse, misleading). Unless fixed, style and signage cycle with the seed: seed s
+is style number s % 4 of office, hospital, museum, campus and signage level number (s // 4) % 3, so any
+12 consecutive seeds cover every pair (with one fixed, the other cycles by s % its count); the park is
+built only when named (style=park). Generated worlds are written to
 DIR/worlds/. Seeds 0-999 are for development; 1000-1999 are test buildings, for reporting only.
 
 Trials differ by seed: start-pose jitter (0.10 m, 3 deg), the recovery's turning direction and, in

@@ -1,6 +1,6 @@
 """Generate buildings and check worlds.
 
-  abstract-map world generate --seed N --out DIR [--style office|hospital|museum|campus]
+  abstract-map world generate --seed N --out DIR [--style office|hospital|museum|campus|park]
                               [--size small|medium|large] [--signage complete|sparse|misleading]
   abstract-map world check DIR [--write-oracle]
 
