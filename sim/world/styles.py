@@ -84,7 +84,7 @@ STYLES: dict[str, Style] = {
         areas=("Savannah", "Rainforest", "Wetlands", "Outback", "Arctic", "Highlands", "Desert", "Reef",
                "Grasslands", "Bushland", "Tundra", "Mangroves"),
         rooms=("Enclosure", "Aviary", "House", "Paddock", "Pool", "Pavilion"),
-        halls=("Picnic Lawn", "Plaza"),
+        halls=("Picnic Lawn", "Plaza"),  # none are made (halls_per_building 0); kept for a park that wants one
         corridor_m=(5.0, 8.0),  # visitor paths with their verges: crowds, prams and service carts side by side
         room_m2=40.0,
         cut_fraction=0.0,  # every path kept, so every block is an island in open ground (a cut path's ground

@@ -153,6 +153,19 @@ def test_the_park_is_open_ground_and_its_arrows_point_nearer_their_places():
     assert not park.layout.halls and (park.layout.raster() > 0).mean() > (office.layout.raster() > 0).mean()
 
 
+def test_wide_paths_leave_a_block_and_a_sign_with_few_places_near_it_skips_between():
+    """Small parks once drew paths wider than their lattice cells (seeds 2 and 3 crashed), and a sign with only
+    two places near it once asked for a "between" of three (medium park seed 14 crashed)."""
+    from sim.world.layout import MIN_BLOCK_M
+    from sim.world.styles import SIZES
+
+    for seed in (2, 3):
+        g = made(seed, "park", "small")
+        widest = max([*g.layout.widths_x.values(), *g.layout.widths_y.values()])
+        assert widest <= SIZES["small"].cell_m[0] - MIN_BLOCK_M + 1e-9 and checked(seed, "park", "small").ok
+    assert checked(14, "park", "medium").ok
+
+
 def test_every_junction_sign_is_read_from_its_junction():
     """A junction's sign hangs where the junction's centre sees its reader, never in a room behind its wall
     (office seed 3 once hung one south of a T's crossing wall, read only from the room below)."""
