@@ -126,15 +126,15 @@ def test_signage_levels_share_the_building():
 
 def arrow_offsets_deg(g) -> list[float]:
     """Per arrow, degrees between its direction and the bearing from its sign to the nearest label of its place."""
-    from sim.world.truth import place_tags
+    from sim.world.truth import angle_between, place_tags
 
     out = []
     for tag, clause in arrows_and_phrases(g.world):
         if isinstance(clause, Locational) and clause.kind == "arrow":
             label = min(place_tags(clause.toponym, g.hierarchy, g.world.tags),
                         key=lambda t: math.hypot(t.x - tag.x, t.y - tag.y))
-            off = math.atan2(label.y - tag.y, label.x - tag.x) - clause.direction
-            out.append(math.degrees(abs((off + math.pi) % (2 * math.pi) - math.pi)))
+            arrow = np.array([math.cos(clause.direction), math.sin(clause.direction)])
+            out.append(angle_between(arrow, np.array([label.x - tag.x, label.y - tag.y])))
     return out
 
 
