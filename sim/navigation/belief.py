@@ -58,7 +58,9 @@ class BeliefParams:
     # it): 14.2 m rms there, 9.9 m a side; kept at 5 m for the same reason
     sigma_per_m: float = 0.35  # m of spread per m between the imagined goal and the nearest observed anchor
     label_offset_m: float = 2.0  # m, a place's label hangs about this far from the place (level-1 label length):
-    # the spread of the label about its place, over the wall there
+    # the spread of the label about its place, over the wall there. It enters twice, in goal_sigma's spread and in
+    # labels_near_places' kernel; counted once the prior is a little narrower and walked no better on development
+    # buildings 64-103 (-0.003 +- 0.005 SPL; docs/method-notes.md, "The label's offset counted once")
     prior_misses: float = 3.0  # how many of the model's misses (below) the spread from ``sigma_min_m`` and
     # ``sigma_per_m`` counts as: a few labels read decide how far the model is trusted in this building
     tail_weight: float = 0.3  # share of the prior in a wide tail: the model may be wrong (a sign misread, a guess)
