@@ -17,8 +17,8 @@ names, measured from a trial's true path and the world's floor plan (never from 
   ``plate_reach_m``) while that plate was still unread (turning in before reading the door's label), when
   the walk's reads are known.
 
-The doorways are the floor plan's free space that a disc of ``door_width_m`` cannot sweep (a binary opening),
-keeping only the narrows the robot fits through. World frame, metres.
+A doorway is free floor whose run along a row or a column of the plan is narrower than ``door_width_m``, where
+the robot's centre fits (:func:`doorway_cells`). World frame, metres.
 """
 
 from __future__ import annotations
