@@ -23,15 +23,17 @@ the robot's centre fits (:func:`doorway_cells`). World frame, metres.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections import defaultdict
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
-from sim.world.data import Floorplan, Tag
-from sim.world.oracle import pool_plan
+from sim.world.data import Floorplan, Tag, World
+from sim.world.oracle import oracle_paths, pool_plan
 
 
 @dataclass(frozen=True)
@@ -240,6 +242,71 @@ def totals(walks: Sequence[Habits]) -> dict[str, float]:
         "doorways again per walk": sum(h.doorways_again for h in walks) / n if n else float("nan"),
         "entered unread per walk": float(np.mean(known)) if known else float("nan"),
     }
+
+
+def record_habits(record: Mapping[str, Any], plan: Floorplan, doorways: np.ndarray,
+                  plates: dict[int, list[Tag]], params: HabitParams = HabitParams()) -> Habits | None:
+    """:func:`habits` of a trial record's walk (its ``trajectory``, rows t s, x m, y m, ...) with the reads of its
+    ``cues`` (a record of no read, a navigator that reads no sign, leaves the doorways entered unread unknown);
+    None for a record without a trajectory."""
+    trajectory = np.asarray(record.get("trajectory") or [], dtype=float)
+    if trajectory.ndim != 2 or trajectory.shape[1] < 3:
+        return None
+    read_s: dict[int, float] = {}
+    for cue in record.get("cues") or []:
+        read_s.setdefault(int(cue["tag_id"]), float(cue["t_s"]))
+    return habits(trajectory[:, 1:3], plan, doorways, params, times=trajectory[:, 0], plates=plates,
+                  read_s=read_s if read_s else None)
+
+
+def study_habits(records: Iterable[Mapping[str, Any]], worlds: Mapping[str, World],
+                 group: Callable[[Mapping[str, Any]], str] = lambda record: "all",
+                 params: HabitParams = HabitParams()) -> tuple[dict[tuple[str, str], list[Habits]], int]:
+    """The habits of ``records``' walks by (navigator, ``group`` of the record), and the oracle's own paths to
+    the same goals under ``"oracle"`` (once per world, goal and group; one search of each world's floor for
+    all its goals); and how many records carried no walk to measure (no trajectory, or a world not in
+    ``worlds``)."""
+    by_world: dict[str, list[Mapping[str, Any]]] = defaultdict(list)
+    unmeasured = 0
+    for record in records:
+        if record.get("world") in worlds:
+            by_world[record["world"]].append(record)
+        else:
+            unmeasured += 1
+    rows: dict[tuple[str, str], list[Habits]] = defaultdict(list)
+    for name, mine in by_world.items():
+        world = worlds[name]
+        plan, doorways = doorway_cells(world.floorplan, params)
+        plates = doorway_plates(plan, doorways, world.tags.values(), params)
+        walked: set[tuple[str, str]] = set()  # (goal, group) walked by some navigator
+        for record in mine:
+            walk = record_habits(record, plan, doorways, plates, params)
+            if walk is None:
+                unmeasured += 1
+                continue
+            rows[record.get("navigator", "paper"), group(record)].append(walk)
+            walked.add((record["goal"], group(record)))
+        paths = oracle_paths(world, sorted({goal for goal, _ in walked})) if walked else {}
+        for goal, key in sorted(walked):
+            rows["oracle", key].append(habits(paths[goal].path, plan, doorways, params))
+    return dict(rows), unmeasured
+
+
+HABIT_COLUMNS = ("turnarounds per 100 m", "revisited %", "weave %", "doorways per walk", "doorways again per walk",
+                 "entered unread per walk")  # the keys of :func:`totals`, in a table's order
+
+
+def habits_table(rows: Mapping[tuple[str, str], Sequence[Habits]], group_name: str = "group") -> list[str]:
+    """Markdown lines: one row per (navigator, group) of :func:`study_habits`, with the walks, the metres walked
+    per walk and :func:`totals`."""
+    lines = [f"| navigator | {group_name} | walks | walked (m) | " + " | ".join(HABIT_COLUMNS) + " |",
+             "|" + " --- |" * (4 + len(HABIT_COLUMNS))]
+    for (navigator, group), walks in sorted(rows.items()):
+        values = totals(walks)
+        walked = sum(h.walked_m for h in walks) / len(walks)
+        cells = ["-" if np.isnan(values[k]) else f"{values[k]:.2f}" for k in HABIT_COLUMNS]
+        lines.append(f"| {navigator} | {group} | {len(walks)} | {walked:.1f} | " + " | ".join(cells) + " |")
+    return lines
 
 
 def _runs(flags: np.ndarray, gap: int) -> int:

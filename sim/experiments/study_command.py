@@ -19,7 +19,8 @@ geometric mode, detection noise (0.03 m, 1 deg). Writes DIR/settings.json, DIR/t
 trial), DIR/trials.csv (world, style, signage, navigator, goal, role, seed, perception, success, reason,
 explanation, distance_m, oracle_m, spl, near_at_m, seen_at_m, sim_s, wall_s, cpu_s), DIR/report.md (success
 rate, SPL, ratio to the oracle and failures by reason: overall, per navigator, style, signage level, goal
-role and world; the ten worst trials with pictures in DIR/worst/) and, for the zoo, the paper's Table I
+role and world; where the walking went and how the walks moved: turnarounds, ground walked again, weave,
+doorways; the ten worst trials with pictures in DIR/worst/) and, for the zoo, the paper's Table I
 extended, DIR/comparison.png (box plots like the paper's Fig. 11) and DIR/paths/GOAL.png. Run again on the
 same DIR to resume (across worlds): finished trials are skipped; other settings on the same DIR are refused.
 """

@@ -105,6 +105,7 @@ def plan_study(worlds: list[World], settings: StudySettings) -> list[TrialSpec]:
 def write_outputs(out: Path, records: list[dict[str, Any]], worlds: list[World], settings: StudySettings,
                   wall_s: float) -> str:
     """report.md (and the pictures it links); returns its text."""
+    from sim.experiments.habits import habits_table, study_habits
     from sim.experiments.report import comparison_plot, goal_rows, load_reference, path_pictures, report_markdown
     from sim.experiments.summary import summary_markdown, worst_pictures, worst_trials
     from sim.world.oracle import oracle_paths
@@ -142,7 +143,11 @@ def write_outputs(out: Path, records: list[dict[str, Any]], worlds: list[World],
                          f"{len(worlds)} world(s); wall time {wall_s / 60:.1f} min.\n")
     worst = worst_trials(records)
     pictures = worst_pictures(worst, by_name, out / "worst")
-    blocks.append(summary_markdown(records, worst=worst, pictures=pictures, relative_to=out))
+    moved, unmeasured = study_habits(records, by_name, lambda r: r.get("signage") or "-")
+    habits = habits_table(moved, "signage") if moved else []
+    if unmeasured:
+        habits += ["", f"{unmeasured} trial(s) carried no walk to measure (no trajectory, or a world not loaded)."]
+    blocks.append(summary_markdown(records, worst=worst, pictures=pictures, relative_to=out, habits=habits))
     report = "\n".join(blocks)
     write_atomic(out / "report.md", report)
     return report

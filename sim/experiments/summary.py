@@ -13,7 +13,7 @@ import itertools
 import math
 import re
 from collections import Counter
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -211,9 +211,10 @@ def worst_pictures(worst: list[Record], worlds: dict[str, World], folder: Path) 
 
 
 def summary_markdown(records: list[Record], *, worst: list[Record], pictures: Iterable[Path | None],
-                     relative_to: Path) -> str:
-    """The sections over all trials: overall, by style and signage, failures, where the walking went, how much
-    a walk depends on its seed, per world, the ten worst."""
+                     relative_to: Path, habits: Sequence[str] = ()) -> str:
+    """The sections over all trials: overall, by style and signage, failures, where the walking went, how the
+    walks moved (``habits``: the table of :func:`sim.experiments.habits.habits_table`; none, no section), how
+    much a walk depends on its seed, per world, the ten worst."""
     nav = lambda r: r.get("navigator", "paper")  # noqa: E731
     generated = any(r.get("style") for r in records)
     lines = ["## Over all trials", "",
@@ -250,6 +251,14 @@ def summary_markdown(records: list[Record], *, worst: list[Record], pictures: It
                   "few are a search that came close and turned away.", "",
                   "| " + " | ".join(walk_header) + " |", "|" + " --- |" * len(walk_header),
                   *["| " + " | ".join(row) + " |" for row in walks]]
+    if habits:
+        lines += ["", "### How the walks moved", "",
+                  "Counted from each walk's true path and the floor plan, beside the oracle's paths to the same goals "
+                  "(`sim/experiments/habits.py`): turning round (the heading 3 m on more than 135 degrees from the "
+                  "heading 3 m before), the share of the walk within 1 m of ground walked 10 m or more before, the "
+                  "share woven beyond the chord on nearly straight 4 m stretches, and per walk the doorways passed "
+                  "(under 1.3 m wide, into a room or out), passed a third time or more (a room entered again) and "
+                  "entered from the side of the label beside them before it was read.", "", *habits]
     spread = seed_spread(records)
     if spread:
         lines += ["", "### How much a walk depends on its seed", "",

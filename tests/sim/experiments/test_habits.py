@@ -17,8 +17,10 @@ from sim.experiments.habits import (
     doorway_entries,
     doorway_plates,
     habits,
+    habits_table,
     resample,
     revisited_m,
+    study_habits,
     totals,
     turnarounds,
     weave,
@@ -126,3 +128,23 @@ def test_totals_are_per_100_m_per_walk_and_shares():
     assert t["doorways per walk"] == 2.0 and t["doorways again per walk"] == 0.5
     assert t["entered unread per walk"] == 2.0  # over the one walk whose reads are known
     assert np.isnan(totals([])["doorways per walk"])
+
+
+def test_a_studys_habits_come_per_navigator_and_group_with_the_oracles_once_per_goal(tiny_world):
+    """Two navigators walk the tiny world's goal in two groups; a record without a walk and one of a world not
+    loaded are counted, not measured."""
+    walk = [[0.4 * i, 1.0 + 0.1 * i, 1.0, 0.0] for i in range(40)]
+    cue = [{"tag_id": 0, "t_s": 10.0}]
+    records = [{"world": "tiny", "goal": "A", "navigator": n, "signage": g, "trajectory": walk, "cues": cue}
+               for n in ("guided", "paper") for g in ("complete", "sparse")]
+    records += [{"world": "tiny", "goal": "A", "navigator": "paper", "signage": "sparse", "trajectory": []},
+                {"world": "elsewhere", "goal": "A", "navigator": "paper", "signage": "sparse", "trajectory": walk}]
+    rows, unmeasured = study_habits(records, {"tiny": tiny_world}, lambda r: r["signage"])
+    assert unmeasured == 2
+    assert sorted(rows) == [(n, g) for n in ("guided", "oracle", "paper") for g in ("complete", "sparse")]
+    assert all(len(walks) == 1 for walks in rows.values())
+    assert rows["guided", "sparse"][0].walked_m == pytest.approx(3.9)
+    assert rows["guided", "sparse"][0].entered_unread == 0 and rows["oracle", "sparse"][0].entered_unread is None
+    table = habits_table(rows, "signage")
+    assert table[0].startswith("| navigator | signage | walks | walked (m) | turnarounds per 100 m")
+    assert len(table) == 2 + 6 and "| oracle | complete | 1 |" in table[4]

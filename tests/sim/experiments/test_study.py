@@ -213,9 +213,12 @@ def test_multi_world_study_resumes_across_worlds_and_refuses_other_settings(tiny
     conduct_study(settings, out, workers=1, progress=lambda done, total, record: calls.append((done, total)))
     assert calls == [(3, 4), (4, 4)]
     report = (out / "report.md").read_text()
-    for section in ("## Over all trials", "### Failures by reason", "### Where the walking went", "### Per world",
-                    "worst trials"):
+    for section in ("## Over all trials", "### Failures by reason", "### Where the walking went",
+                    "### How the walks moved", "### Per world", "worst trials"):
         assert section in report
+    moved = report[report.index("### How the walks moved"):report.index("### Per world")]
+    assert [line.split("|")[1].strip() for line in moved.splitlines() if line.startswith("| ")][2:] == [
+        "frontier", "oracle", "paper"]  # a row per navigator and the oracle's, after the header and its rule
     with pytest.raises(StudyError, match="trials"):
         conduct_study(settings_for(tiny_world, worlds=settings.worlds, navigators=settings.navigators, trials=2),
                       out, workers=1)
