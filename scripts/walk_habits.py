@@ -4,7 +4,7 @@ Usage: ``python scripts/walk_habits.py DIR [DIR ...] [--by FIELD]``: each ``DIR`
 (``DIR/trials/WORLD/*.json``; a ``generalise`` folder's parts, ``DIR/geometric`` and ``DIR/camera``, are study
 folders too). Worlds are read from ``DIR/worlds/WORLD`` (generated buildings) or ``worlds/WORLD``. One row per
 navigator (and per value of ``--by``: signage, style, role, perception, success), and one for the oracle's
-own paths to the same goals: trials, metres walked per trial, turnarounds per 100 m, the share of the walk
+own paths to the same goals: walks, metres walked per walk, turnarounds per 100 m, the share of the walk
 over ground already walked and the share woven beyond the chord on nearly straight stretches (%), and per
 walk the doorways passed (into a room or out of one), passed again (a room entered again) and entered from
 the side of a plate beside them before it was read (over the walks that record what they read: not the

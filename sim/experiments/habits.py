@@ -296,6 +296,17 @@ HABIT_COLUMNS = ("turnarounds per 100 m", "revisited %", "weave %", "doorways pe
                  "entered unread per walk")  # the keys of :func:`totals`, in a table's order
 
 
+def habits_legend(params: HabitParams = HabitParams()) -> str:
+    """One paragraph saying what :func:`habits_table`'s columns count, with ``params``' values."""
+    return (f"Counted from each walk's true path and the floor plan, beside the oracle's paths to the same goals "
+            f"(`sim/experiments/habits.py`): turning round (the heading {params.turn_window_m:g} m on more than "
+            f"{params.turn_deg:g} degrees from the heading {params.turn_window_m:g} m before), the share of the walk "
+            f"within {params.revisit_m:g} m of ground walked {params.revisit_gap_m:g} m or more before, the share "
+            f"woven beyond the chord on nearly straight {params.weave_window_m:g} m stretches, and per walk the "
+            f"doorways passed (under {params.door_width_m:g} m wide, into a room or out), passed a third time or "
+            f"more (a room entered again) and entered from the side of the label beside them before it was read.")
+
+
 def habits_table(rows: Mapping[tuple[str, str], Sequence[Habits]], group_name: str = "group") -> list[str]:
     """Markdown lines: one row per (navigator, group) of :func:`study_habits`, with the walks, the metres walked
     per walk and :func:`totals`."""

@@ -22,6 +22,7 @@ import numpy as np
 
 from abstract_map.files import atomic_path
 from sim.experiments.diagnosis import KINDS
+from sim.experiments.habits import habits_legend
 from sim.experiments.pictures import draw_floorplan, draw_path, draw_tags, draw_walk_marks
 from sim.experiments.walk import PHASES, phase_means
 from sim.world.data import World
@@ -252,13 +253,7 @@ def summary_markdown(records: list[Record], *, worst: list[Record], pictures: It
                   "| " + " | ".join(walk_header) + " |", "|" + " --- |" * len(walk_header),
                   *["| " + " | ".join(row) + " |" for row in walks]]
     if habits:
-        lines += ["", "### How the walks moved", "",
-                  "Counted from each walk's true path and the floor plan, beside the oracle's paths to the same goals "
-                  "(`sim/experiments/habits.py`): turning round (the heading 3 m on more than 135 degrees from the "
-                  "heading 3 m before), the share of the walk within 1 m of ground walked 10 m or more before, the "
-                  "share woven beyond the chord on nearly straight 4 m stretches, and per walk the doorways passed "
-                  "(under 1.3 m wide, into a room or out), passed a third time or more (a room entered again) and "
-                  "entered from the side of the label beside them before it was read.", "", *habits]
+        lines += ["", "### How the walks moved", "", habits_legend(), "", *habits]
     spread = seed_spread(records)
     if spread:
         lines += ["", "### How much a walk depends on its seed", "",
