@@ -211,6 +211,24 @@ def generalise_tables(records: list[dict], title: str) -> None:
     walk_phases(records, title)
 
 
+def walk_habits(records: list[dict], out: Path, title: str) -> None:
+    """How the walks moved (``sim.experiments.habits``) per navigator and perception, beside the oracle's paths,
+    the worlds read from the run's own ``out/PART/worlds/``."""
+    from sim.experiments.habits import habits_table, study_habits
+    from sim.world.data import load_world
+
+    worlds = {}
+    for name in sorted({r["world"] for r in records}):
+        folders = sorted(out.glob(f"*/worlds/{name}"))
+        if folders:
+            worlds[name] = load_world(folders[0])
+    rows, unmeasured = study_habits(records, worlds, lambda r: r["perception"])
+    print(f"\n{title}, how the walks moved")
+    print("\n".join(habits_table(rows, "perception")))
+    if unmeasured:
+        print(f"({unmeasured} trial(s) without a walk or a world to measure)")
+
+
 def walk_phases(records: list[dict], title: str) -> None:
     """Where the walking went (``sim.experiments.walk``) per perception, navigator and signage level."""
     from sim.experiments.summary import WALK_HEADER, walk_rows
@@ -293,6 +311,7 @@ def bench_generalise(suite: GeneraliseSuite = GeneraliseSuite(), workers: int = 
     if report_only:
         records = finished_trials(out)
         generalise_tables(records, f"Generalisation, the {len(records)} trials finished so far in {out}")
+        walk_habits(records, out, "Generalisation")
         return
     began = time.perf_counter()
     parts = [("geometric", suite.buildings, suite.geometric), ("camera", suite.camera_buildings, suite.camera)]
@@ -317,6 +336,7 @@ def bench_generalise(suite: GeneraliseSuite = GeneraliseSuite(), workers: int = 
     generalise_tables(records, f"Generalisation over test buildings {suite.worlds(suite.buildings)} "
                                f"(camera: first {suite.camera_buildings}), 1 trial per goal, cap "
                                f"{suite.max_sim_s:.0f} s, {workers} workers")
+    walk_habits(records, out, "Generalisation")
     print(f"benchmark wall time: {wall / 60:.1f} min (trials resumed from {out} not counted)")
 
 

@@ -31,6 +31,8 @@ def test_a_tiny_generalise_suite_runs_and_tabulates(tmp_path, capsys, monkeypatc
     printed = capsys.readouterr().out
     assert "| geometric  | frontier  | all" in printed and "| geometric  | guided    | all" in printed
     assert "failures explained" in printed and "reads no signs" in printed  # a 10 s frontier run finds nothing
+    moved = printed[printed.index("how the walks moved"):]
+    assert "| frontier | geometric | 5 |" in moved and "| oracle | geometric | 5 |" in moved  # the goals once
     records = run.finished_trials(tmp_path / "gen")
     assert len(records) == 10  # 5 goals x 2 navigators; the frontier's 5 from one shared run
     assert {r["world"] for r in records} == {"gen-office-medium-sparse-1000"}
