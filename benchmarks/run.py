@@ -213,15 +213,18 @@ def generalise_tables(records: list[dict], title: str) -> None:
 
 def walk_habits(records: list[dict], out: Path, title: str) -> None:
     """How the walks moved (``sim.experiments.habits``) per navigator and perception, beside the oracle's paths,
-    the worlds read from the run's own ``out/PART/worlds/``."""
+    the worlds read from the run's own ``out/PART/worlds/`` (``sim.experiments.compare.study_world``)."""
+    from sim.experiments.compare import study_world
     from sim.experiments.habits import habits_table, study_habits
-    from sim.world.data import load_world
+    from sim.world.data import WorldError
 
+    parts = sorted(part for part in out.iterdir() if part.is_dir())
     worlds = {}
     for name in sorted({r["world"] for r in records}):
-        folders = sorted(out.glob(f"*/worlds/{name}"))
-        if folders:
-            worlds[name] = load_world(folders[0])
+        try:
+            worlds[name] = study_world(parts, name)
+        except WorldError:
+            continue  # counted below as a trial without a world to measure
     rows, unmeasured = study_habits(records, worlds, lambda r: r["perception"])
     print(f"\n{title}, how the walks moved")
     print("\n".join(habits_table(rows, "perception")))

@@ -2,7 +2,7 @@
 
 Usage: ``python scripts/walk_habits.py DIR [DIR ...] [--by FIELD]``: each ``DIR`` a study folder
 (``DIR/trials/WORLD/*.json``; a ``generalise`` folder's parts, ``DIR/geometric`` and ``DIR/camera``, are study
-folders too). Worlds are read from ``DIR/worlds/WORLD`` (generated buildings) or ``worlds/WORLD``. One row per
+folders too). Worlds are read from ``DIR/worlds/WORLD`` (generated buildings) or by name (``zoo``). One row per
 navigator (and per value of ``--by``: signage, style, role, perception, success), and one for the oracle's
 own paths to the same goals: walks, metres walked per walk, turnarounds per 100 m, the share of the walk
 over ground already walked and the share woven beyond the chord on nearly straight stretches (%), and per
@@ -21,11 +21,10 @@ from pathlib import Path
 from tqdm import tqdm
 
 from abstract_map.errors import AbstractMapError
-from sim.experiments.compare import CompareError, load_records
+from sim.experiments.compare import CompareError, load_records, study_world
 from sim.experiments.habits import habits_table, study_habits
-from sim.world.data import World, load_world
+from sim.world.data import World
 
-ROOT = Path(__file__).resolve().parents[1]
 BY = ("signage", "style", "role", "perception", "success")
 
 
@@ -34,12 +33,6 @@ def study_folders(folder: Path) -> list[Path]:
     if (folder / "trials").is_dir():
         return [folder]
     return sorted(part for part in folder.iterdir() if (part / "trials").is_dir()) if folder.is_dir() else []
-
-
-def world_folder(study: Path, name: str) -> Path:
-    """Where the study's world ``name`` lies: its own ``worlds/`` first, then the repository's."""
-    own = study / "worlds" / name
-    return own if own.is_dir() else ROOT / "worlds" / name
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -60,7 +53,7 @@ def main(argv: list[str] | None = None) -> int:
                 parser.exit(2, f"walk_habits: {error}\n")
             for name in sorted({r["world"] for r in found} - set(worlds)):
                 try:
-                    worlds[name] = load_world(world_folder(part, name))
+                    worlds[name] = study_world([part], name)
                 except AbstractMapError as error:
                     parser.exit(2, f"walk_habits: world {name!r} of {part}: {error}\n")
             records += found

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from sim.experiments.walk import PHASES, phase_means
+from sim.world.data import World, load_world
 
 Record = dict[str, Any]
 Key = tuple[Any, ...]
@@ -93,6 +94,17 @@ def load_records(folder: Path, navigator: str | None = None) -> list[Record]:
     if not records:
         raise CompareError(f"{folder}: no trials of navigator {navigator!r}")
     return records
+
+
+def study_world(folders: Sequence[Path], name: str) -> World:
+    """The world ``name`` that study ``folders`` ran: the first one's own ``worlds/NAME`` (its generated
+    buildings), else a named world (:func:`sim.world.data.load_world`, e.g. ``zoo``); its
+    :class:`~sim.world.data.WorldError` when neither is there."""
+    for folder in folders:
+        own = Path(folder) / "worlds" / name
+        if own.is_dir():
+            return load_world(own)
+    return load_world(name)
 
 
 def pair_key(record: Record, with_navigator: bool) -> Key:

@@ -124,3 +124,15 @@ def test_command_bad_input_is_one_line_and_exit_2(tmp_path, capsys, argv, messag
     assert main(["compare", *args]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and message in err[0]
+
+
+def test_a_studys_world_is_its_own_generated_building_first_then_a_named_world(tmp_path):
+    from sim.experiments.compare import study_world
+    from sim.world.data import WorldError
+    from tests.sim.conftest import write_world
+
+    write_world(tmp_path / "b" / "worlds" / "tiny")
+    assert study_world([tmp_path / "a", tmp_path / "b"], "tiny").root == tmp_path / "b" / "worlds" / "tiny"
+    assert study_world([tmp_path / "a"], "zoo").name == "zoo"  # not in the study: the named world
+    with pytest.raises(WorldError, match="nowhere"):
+        study_world([tmp_path / "b"], "nowhere")
