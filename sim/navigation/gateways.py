@@ -62,6 +62,10 @@ class GuideParams:
     look_ahead_m: tuple[float, ...] = (0.0, 3.0, 6.0, 12.0, 24.0, 48.0, 96.0)  # m walked past a frontier over which
     # its worth is the best rate of belief per metre (module docstring): doubling steps from one look (3 m) to
     # about a building's span; empty: a frontier is worth all the mass behind it, however far
+    even_spread_m: float = 1000.0  # m, the ``even-prior`` ablation's floor on the goal prior's spread, for every
+    # way the cues name the goal (``BeliefParams.floor_m``): far beyond any building, so the prior lies even over
+    # the map (the model's misses average it down slowly: to about 300 m after 30 labels read) until labels of the
+    # goal's siblings are read, which then hold it
     known_front_m: float = 1.5  # m in front of the goal's label the ``known-pose`` reference drives to: past the
     # camera's 1 m near limit and well inside the 4 m reading range
     known_spread_m: float = 1.0  # m, the ``known-goal`` baseline's prior about the goal's true label: the label to

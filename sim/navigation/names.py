@@ -16,6 +16,8 @@ NAVIGATOR_SUMMARIES: dict[str, str] = {
     "viewpoint": "negative information: to where the goal's label may still be read",
     "guided": "the frontier with the best rate of goal belief per metre walked past it, from the arrows, signs, "
               "doorways and abstract map; it reads the plates it sees from afar",
+    "even-prior": "guided without the abstract map's imagined goal (the goal's prior even over the map): an "
+                  "ablation, what the model's point is worth in a building",
     "known-goal": "guided told where the goal's label hangs: an informed reference, not a navigator for unseen "
                   "buildings",
     "known-pose": "told where the goal's label hangs and which way it faces, straight there over the map as it "

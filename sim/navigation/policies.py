@@ -22,6 +22,9 @@ differs is where it wants to go. Register a new one in :data:`NAVIGATORS`.
   past it as a walk there pays (:mod:`sim.navigation.gateways`), ruling out
   walls seen from afar without a plate and stepping in front of plates seen but
   unread (:mod:`sim.navigation.spotted`).
+- ``even-prior``: ``guided`` with the goal's prior even over the map until
+  labels of its siblings are read: the ablation of the abstract map's imagined
+  goal.
 - ``known-goal``: ``guided`` with the goal's prior on its true label (the
   world's truth): what this search walks when it knows where the goal is but
   not the building, beside ``frontier``'s lower bound.
@@ -697,6 +700,30 @@ def oracle_label(world: World, goal: str, start: Pose) -> Tag:
         return world.tags[oracle_path(world, goal).tag_id]
 
 
+class EvenPriorPolicy(GuidedPolicy):
+    """``guided`` without the abstract map's imagined goal: an ablation that says what the model's point is worth.
+
+    The goal prior's least spread, for every way the cues name the goal, is
+    ``GuideParams.even_spread_m`` (1 km), so the prior lies even over the map
+    until labels of the goal's siblings are read, which then hold it
+    (:func:`sim.navigation.belief.prior_components`: a model that says nothing
+    hands its share to them). The arrows, the signs that do not name the goal,
+    door depth, the plates seen and the space looked at weigh it as in
+    ``guided``. On the generator's buildings it walks shorter than ``guided``
+    (their arrows give a route's first leg, not a bearing, so the model's point
+    is worth less than none); in the zoo, whose arrows point at their places,
+    it walks about 2.4 times the oracle (``docs/method-notes.md``, "What the
+    imagined goal is worth" and "What telling the two kinds of building apart
+    would be worth on the test split").
+    """
+
+    def goal_prior(self, belief: BeliefParams | None = None) -> GoalPrior:
+        spread = self.params.guide.even_spread_m
+        even = replace(belief or self.params.belief, sigma_min_m=spread, sigma_min_arrow_m=spread,
+                       sigma_min_hierarchy_m=spread)
+        return super().goal_prior(even)
+
+
 class KnownGoalPolicy(GuidedPolicy):
     """``guided`` told where the goal's label hangs: an informed reference, not a navigator for unseen buildings.
 
@@ -757,6 +784,7 @@ NAVIGATORS: dict[str, type] = {
     "frontier": FrontierPolicy,
     "viewpoint": ViewpointPolicy,
     "guided": GuidedPolicy,
+    "even-prior": EvenPriorPolicy,
     "known-goal": KnownGoalPolicy,
     "known-pose": KnownPosePolicy,
 }

@@ -7,7 +7,7 @@ import pytest
 from sim.experiments.trial import run_trial
 from sim.navigation.policies import NAVIGATORS
 
-SEARCHERS = ["viewpoint", "guided", "known-goal"]  # the navigators that keep a belief layer and a swept layer
+SEARCHERS = ["viewpoint", "guided", "even-prior", "known-goal"]  # navigators with a belief layer and a swept layer
 
 
 def test_searchers_are_navigators_beside_paper():
@@ -304,3 +304,31 @@ def test_known_pose_drives_to_the_front_of_the_label_the_oracle_reads(tmp_path):
     assert result.success, result.reason
     assert result.cues == []  # it reads no sign
     assert result.distance_m < world.oracle_m[goal] * 1.5 + 2.0
+
+
+def test_even_prior_is_guided_with_the_abstract_maps_point_dropped(tiny_world):
+    """The ablation's goal prior is as wide as the map many times over, about the same imagined goal as
+    ``guided``'s; a label of a sibling read takes all but a sliver of it; everything else is ``guided``'s."""
+    import numpy as np
+
+    from sim.experiments.trial import TrialParams, occupancy_grid, policy_params
+    from sim.navigation.belief import GoalPrior, prior_components
+    from sim.navigation.policies import EvenPriorPolicy, GuidedPolicy
+
+    params = policy_params(TrialParams())
+    goal = sorted(tiny_world.goals)[0]
+    guided = GuidedPolicy(tiny_world, goal, tiny_world.start, params)
+    even = EvenPriorPolicy(tiny_world, goal, tiny_world.start, params)
+    mine, theirs = even.goal_prior(), guided.goal_prior()
+    assert np.allclose(mine.centre, theirs.centre)
+    assert theirs.sigma_m < 50.0 and mine.sigma_m > 0.9 * params.guide.even_spread_m
+    family = GoalPrior(mine.centre, mine.sigma_m, np.array([[1.0, 2.0]]))
+    (own, _, _), (sibling, centre, _) = prior_components(family, params.belief)
+    assert own < 1e-3 and sibling > 0.999 and np.allclose(centre, [1.0, 2.0])
+    grid = occupancy_grid(tiny_world, TrialParams())
+    even.command(0.0, tiny_world.start, grid, 0.2, np.random.default_rng(0))
+    guided.command(0.0, tiny_world.start, grid, 0.2, np.random.default_rng(0))
+    def peak(mass: np.ndarray) -> float:  # the belief's peak over its mean where it is not ruled out
+        return float(mass.max() / mass[mass > 0].mean())
+
+    assert peak(even.belief.mass) < 1.5 < peak(guided.belief.mass)  # what is left of even's is the evidence's
