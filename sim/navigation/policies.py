@@ -703,9 +703,10 @@ def oracle_label(world: World, goal: str, start: Pose) -> Tag:
 class EvenPriorPolicy(GuidedPolicy):
     """``guided`` without the abstract map's imagined goal: an ablation that says what the model's point is worth.
 
-    The goal prior's least spread, for every way the cues name the goal, is
-    ``GuideParams.even_spread_m`` (1 km), so the prior lies even over the map
-    until labels of the goal's siblings are read, which then hold it
+    The floor of the goal prior's spread, for every way the cues name the goal,
+    is ``GuideParams.even_spread_m`` (1 km; the model's misses average it down
+    only slowly), so the prior lies even over the map until labels of the
+    goal's siblings are read, which then hold it
     (:func:`sim.navigation.belief.prior_components`: a model that says nothing
     hands its share to them). The arrows, the signs that do not name the goal,
     door depth, the plates seen and the space looked at weigh it as in

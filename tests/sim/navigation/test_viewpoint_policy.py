@@ -307,8 +307,9 @@ def test_known_pose_drives_to_the_front_of_the_label_the_oracle_reads(tmp_path):
 
 
 def test_even_prior_is_guided_with_the_abstract_maps_point_dropped(tiny_world):
-    """The ablation's goal prior is as wide as the map many times over, about the same imagined goal as
-    ``guided``'s; a label of a sibling read takes all but a sliver of it; everything else is ``guided``'s."""
+    """The ablation's goal prior lies about the same imagined goal as ``guided``'s but is as wide as the map many
+    times over, so a label of a sibling read takes all but a sliver of it, and its first belief is all but flat
+    where ``guided``'s peaks."""
     import numpy as np
 
     from sim.experiments.trial import TrialParams, occupancy_grid, policy_params
