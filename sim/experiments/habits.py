@@ -173,9 +173,7 @@ def doorway_plates(plan: Floorplan, doorways: np.ndarray, tags: Iterable[Tag],
     cells = np.argwhere(doorways > 0)
     if len(cells) == 0:
         return {}
-    xy = np.column_stack([plan.origin[0] + (cells[:, 1] + 0.5) * plan.resolution,
-                          plan.origin[1] + (plan.shape[0] - cells[:, 0] - 0.5) * plan.resolution])
-    tree = cKDTree(xy)
+    tree = cKDTree(plan.pixel_to_world(cells))
     out: dict[int, list[Tag]] = {}
     for tag in tags:
         if tag.kind != "label":
