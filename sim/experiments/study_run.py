@@ -75,7 +75,7 @@ def build_worlds(settings: StudySettings, out: Path, *, workers: int = 1) -> lis
 def _folder_name(spec: GeneratedSpec, root: Path) -> Path:
     from sim.world.generator import world_name
 
-    return root / world_name(spec.seed, spec.style, spec.size, spec.signage)
+    return root / world_name(spec.seed, spec.style, spec.size, spec.signage, spec.arrows)
 
 
 def plan_study(worlds: list[World], settings: StudySettings) -> list[TrialSpec]:

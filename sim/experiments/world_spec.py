@@ -14,6 +14,9 @@ Forms (``--world`` may be given several times; a study runs over all of them):
   (by ``s % len``).
 - ``generated:1000-1009:style=hospital,signage=sparse,size=small``: fixed
   settings, any subset of ``style``, ``size`` and ``signage``.
+- ``generated:0-19:style=park,arrows=bearing``: the same buildings with
+  fingerposts, arrows pointing at their places as the crow flies, instead of
+  the way to set off (``arrows=way``, the default; ``sim.world.truth``).
 
 Seeds 0-999 are for development (tuning), 1000-1999 only for reporting:
 :func:`seed_split` names the split of a seed. Generated worlds are written
@@ -48,6 +51,7 @@ class GeneratedSpec:
     style: str
     size: str
     signage: str
+    arrows: str = "way"  # what the signs' arrows point along (``sim.world.truth.ARROW_READINGS``)
 
 
 @dataclass(frozen=True)
@@ -60,6 +64,7 @@ class WorldSpec:
     style: str | None = None  # None: cycles with the seed
     size: str = "medium"
     signage: str | None = None  # None: cycles with the seed
+    arrows: str = "way"  # the route's first leg (wayfinding signs) or ``bearing`` (fingerposts)
 
     def generated(self) -> list[GeneratedSpec]:
         """The buildings of a ``generated:`` spec, in seed order (empty for a named world)."""
@@ -77,7 +82,7 @@ class WorldSpec:
                 level = levels[seed % len(levels)]
             else:
                 level = levels[(seed // len(styles)) % len(levels)]
-            out.append(GeneratedSpec(seed, style, self.size, level))
+            out.append(GeneratedSpec(seed, style, self.size, level, self.arrows))
         return out
 
 
@@ -88,6 +93,7 @@ def parse_world_spec(text: str) -> WorldSpec:
             raise WorldSpecError("--world: empty; expected a world name, a folder or generated:A-B")
         return WorldSpec(text=text, path=text)
     from sim.world.styles import SIGNAGE, SIZES, STYLES
+    from sim.world.truth import ARROW_READINGS
 
     example = "e.g. generated:1000-1049 or generated:1000-1009:style=hospital,signage=sparse"
     body = text[len(GENERATED):]
@@ -101,7 +107,7 @@ def parse_world_spec(text: str) -> WorldSpec:
         raise WorldSpecError(f"--world {text!r}: seeds run from low to high, {example}")
     if last - first + 1 > MAX_WORLDS:
         raise WorldSpecError(f"--world {text!r}: {last - first + 1} worlds; at most {MAX_WORLDS} per spec")
-    tables = {"style": STYLES, "size": SIZES, "signage": SIGNAGE}
+    tables = {"style": STYLES, "size": SIZES, "signage": SIGNAGE, "arrows": ARROW_READINGS}
     options: dict[str, str] = {}
     for item in filter(None, options_text.split(",")):
         key, eq, value = item.partition("=")
@@ -115,7 +121,7 @@ def parse_world_spec(text: str) -> WorldSpec:
             raise WorldSpecError(f"--world {text!r}: {key} given twice")
         options[key] = value
     return WorldSpec(text=text, seeds=(first, last), style=options.get("style"), size=options.get("size", "medium"),
-                     signage=options.get("signage"))
+                     signage=options.get("signage"), arrows=options.get("arrows", "way"))
 
 
 def seed_split(seed: int) -> str:
@@ -127,7 +133,8 @@ def generated_folder(spec: GeneratedSpec, root: Path) -> Path:
     """Where ``spec``'s building lives under ``root`` (written there if absent)."""
     from sim.world.generator import generated_world
 
-    return generated_world(spec.seed, style=spec.style, size=spec.size, signage=spec.signage, root=root)
+    return generated_world(spec.seed, style=spec.style, size=spec.size, signage=spec.signage, arrows=spec.arrows,
+                           root=root)
 
 
 def resolve_worlds(specs: Iterable[WorldSpec], root: Path, *,

@@ -13,7 +13,9 @@ message. It checks, with the rules of ``truth``:
   the hierarchy;
 - ``room``/``goal``: every room (a leaf of the hierarchy) and every goal has a
   label readable from reachable space; each goal's oracle is computed;
-- ``arrow``: every arrow lies within 45 degrees of its route's first leg;
+- ``arrow``: every arrow lies within 45 degrees of its route's first leg (of
+  its place's bearing in a world whose ``generator.arrows`` is ``bearing``:
+  ``truth.ARROW_READINGS``);
 - ``phrase``: every phrase is true by its preposition's test;
 - ``oracle``: a stored ``oracle_m`` agrees with the computed one (0.05 m + 1 %).
 
@@ -36,11 +38,13 @@ from abstract_map.hierarchy import Hierarchy, HierarchyError
 from sim.world.data import Tag, World
 from sim.world.oracle import oracle_paths
 from sim.world.truth import (
+    ARROW_READINGS,
+    DEFAULT_ARROWS,
+    ArrowReading,
     Facts,
     RouteField,
     Routes,
     TruthParams,
-    first_leg,
     hang,
     phrase_verdict,
     place_positions,
@@ -159,6 +163,11 @@ def check_world(world: World, *, hierarchy: Hierarchy | None = None, params: Tru
             facts.positions[f"#{tag.id}"] = np.array([tag.x, tag.y])
             facts.facing[f"#{tag.id}"] = tag.theta
     declared = {(int(m["tag"]), str(m["name"])) for m in (world.generator or {}).get("misleading", [])}
+    arrows = str((world.generator or {}).get("arrows", DEFAULT_ARROWS))
+    if arrows not in ARROW_READINGS:
+        report.add("arrow", "world", f"generator.arrows {arrows!r}: expected one of {', '.join(ARROW_READINGS)}; "
+                   f"arrows checked as {DEFAULT_ARROWS!r}")
+        arrows = DEFAULT_ARROWS
     n_arrows = n_phrases = 0
     for tag_id, found in sorted(clauses.items()):
         tag = world.tags[tag_id]
@@ -171,7 +180,8 @@ def check_world(world: World, *, hierarchy: Hierarchy | None = None, params: Tru
                 n_arrows += 1
                 if field_ is None and pose is not None:
                     field_ = routes.field_from(pose)
-                problem = _arrow_problem(clause, tag, field_, routes, hierarchy, world, facts)
+                problem = _arrow_problem(clause, tag, field_, routes, hierarchy, world, facts,
+                                         ARROW_READINGS[arrows])
                 if problem:
                     report.add("arrow", f"tag {tag_id}", problem, declared=(tag_id, clause.toponym) in declared)
             elif isinstance(clause, Relational):
@@ -196,7 +206,7 @@ def _phrase(clause: Relational, tag_id: int) -> str:
 
 
 def _arrow_problem(clause: Locational, tag: Tag, field_: RouteField | None, routes: Routes, hierarchy: Hierarchy,
-                   world: World, facts: Facts) -> str | None:
+                   world: World, facts: Facts, reading: ArrowReading) -> str | None:
     name = clause.toponym
     arrow = _arrow_word(tag.theta, clause.direction)
     head = f"${arrow}$ {name}"
@@ -208,13 +218,13 @@ def _arrow_problem(clause: Locational, tag: Tag, field_: RouteField | None, rout
     path = field_.route_to(targets)
     if path is None:
         return f"{head}: {name!r} cannot be reached from in front of the sign"
-    leg = first_leg(path, facts.positions.get(name), routes.params)
+    leg = reading.direction(path, facts.positions.get(name), routes.params)
     if leg is None:
-        return f"{head}: the route has no first leg"
+        return f"{head}: {reading.describes} is not defined"
     error = abs(math.degrees(math.remainder(leg - clause.direction, math.tau)))
     if error <= routes.params.tolerance_deg:
         return None
-    return (f"{head}: the arrow points {math.degrees(clause.direction):.0f} deg, the route's first leg "
+    return (f"{head}: the arrow points {math.degrees(clause.direction):.0f} deg, {reading.describes} "
             f"{math.degrees(leg):.0f} deg ({error:.0f} deg off; route {_length(path):.1f} m)")
 
 

@@ -2,15 +2,20 @@
 
   abstract-map world generate --seed N --out DIR [--style office|hospital|museum|campus|park]
                               [--size small|medium|large] [--signage complete|sparse|misleading]
+                              [--arrows way|bearing]
   abstract-map world check DIR [--write-oracle]
 
 `generate` writes a world folder (world.json with the oracle per goal,
 floorplan.png, tags.json, hierarchy.xml); the same arguments give the same
-bytes. It refuses a non-empty DIR unless DIR holds exactly this generation.
+bytes. `--arrows bearing` writes fingerposts (each arrow points at its place
+as the crow flies) instead of wayfinding signs (each points the way to set
+off: the default, `way`); the building is otherwise the same. It refuses a
+non-empty DIR unless DIR holds exactly this generation.
 
 `check` checks any world folder (or world name): tags on walls and readable
 from reachable space, every room and goal reachable, every arrow within 45
-degrees of its route's first leg, every phrase true, the stored oracle current.
+degrees of its route's first leg (of its place's bearing, in a world generated
+with `--arrows bearing`), every phrase true, the stored oracle current.
 It prints a table of what fails and exits 1 when anything fails, 0 otherwise.
 `--write-oracle` stores the computed oracle per goal in world.json.
 """
@@ -29,6 +34,7 @@ EXTRA = "sim"
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from sim.world.styles import SIGNAGE, SIZES, STYLES
+    from sim.world.truth import ARROW_READINGS, DEFAULT_ARROWS
 
     sub = parser.add_subparsers(dest="action", metavar="ACTION")
     gen = sub.add_parser("generate", help="write a generated building as a world folder",
@@ -38,6 +44,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     gen.add_argument("--style", default="office", help=f"one of {', '.join(STYLES)} (default office)")
     gen.add_argument("--size", default="medium", help=f"one of {', '.join(SIZES)} (default medium)")
     gen.add_argument("--signage", default="complete", help=f"one of {', '.join(SIGNAGE)} (default complete)")
+    gen.add_argument("--arrows", default=DEFAULT_ARROWS,
+                     help=f"what arrows point along: one of {', '.join(ARROW_READINGS)} (default {DEFAULT_ARROWS}: "
+                          "the way to set off; bearing: the place, as fingerposts do)")
     chk = sub.add_parser("check", help="check a world folder; exit 1 when anything fails",
                          description="Check a world against its floor plan; exit 1 when anything fails.")
     chk.add_argument("world", help="world folder or name")
@@ -61,7 +70,7 @@ def _generate(args: argparse.Namespace) -> int:
         raise ExitError(f"--seed must be a non-negative integer, got {args.seed!r}") from None
     t0 = time.perf_counter()
     try:
-        generated = generate(seed, style=args.style, size=args.size, signage=args.signage)
+        generated = generate(seed, style=args.style, size=args.size, signage=args.signage, arrows=args.arrows)
         folder = write_world(generated, args.out)
     except (ValueError, FileExistsError) as exc:
         raise ExitError(str(exc)) from None

@@ -1,7 +1,11 @@
 """Generate a building in the world-folder format: plan, labels, signs, hierarchy, start and five goals.
 
-``generate(seed, style=, size=, signage=)`` is pure (no files): the same
-arguments give the same bytes. ``write_world`` writes the folder atomically;
+``generate(seed, style=, size=, signage=, arrows=)`` is pure (no files): the
+same arguments give the same bytes. ``arrows`` says what the signs' arrows
+point along (``truth.ARROW_READINGS``): ``way``, the route's first leg, as a
+building's wayfinding signs do (the default), or ``bearing``, the place
+itself, as fingerposts do; the layout, labels and goals do not depend on it.
+``write_world`` writes the folder atomically;
 ``generated_world`` writes it under a root once and returns it. The plan comes
 from ``layout``, the signs from ``signage``, and everything the signs say is
 true by ``truth`` (misleading signage excepted: its wrong arrows are listed in
@@ -46,7 +50,16 @@ from sim.world.oracle import oracle_paths
 from sim.world.signage import EXTRA_NAMES, Sign, Writer, sign_spots
 from sim.world.signage import _tag as _sign_tag
 from sim.world.styles import SIGNAGE, SIZES, STYLES, Size, Style, lookup
-from sim.world.truth import Facts, Routes, TruthParams, arrow_direction, hang, place_positions
+from sim.world.truth import (
+    ARROW_READINGS,
+    DEFAULT_ARROWS,
+    Facts,
+    Routes,
+    TruthParams,
+    arrow_direction,
+    hang,
+    place_positions,
+)
 
 FILES = ("world.json", "floorplan.png", "tags.json", "hierarchy.xml")
 N_TAG_IDS = 587  # AprilTag 36h11 has ids 0-586
@@ -68,6 +81,7 @@ class GeneratedWorld:
     layout: Layout
     goal_roles: dict[str, str]  # goal -> "loop" | "dead end" | "no arrow" | "hall" | "through room" | "far"
     misleading: list[dict[str, Any]]  # {"tag", "name", "arrow"}: arrows written wrong on purpose
+    arrows: str = DEFAULT_ARROWS  # what the arrows point along (``truth.ARROW_READINGS``)
 
     def check(self):  # type: ignore[no-untyped-def]
         """``check_world`` on the world in memory (its hierarchy is not on disk): a ``CheckReport``."""
@@ -76,8 +90,10 @@ class GeneratedWorld:
         return check_world(self.world, hierarchy=self.hierarchy)
 
 
-def world_name(seed: int, style: str, size: str, signage: str) -> str:
-    return f"gen-{style}-{size}-{signage}-{seed}"
+def world_name(seed: int, style: str, size: str, signage: str, arrows: str = DEFAULT_ARROWS) -> str:
+    """``gen-STYLE-SIZE-SIGNAGE-SEED``, with ``-ARROWS`` before the seed when the arrows are not the default's."""
+    reading = "" if arrows == DEFAULT_ARROWS else f"{arrows}-"
+    return f"gen-{style}-{size}-{signage}-{reading}{seed}"
 
 
 # -- hierarchy -------------------------------------------------------------------------------------------
@@ -210,9 +226,11 @@ def _png(image: np.ndarray) -> bytes:
     return buffer.getvalue()
 
 
-def generate(seed: int, *, style: str = "office", size: str = "medium", signage: str = "complete") -> GeneratedWorld:
+def generate(seed: int, *, style: str = "office", size: str = "medium", signage: str = "complete",
+             arrows: str = DEFAULT_ARROWS) -> GeneratedWorld:
     """A building from ``seed`` (module docstring); pure: no files, same arguments, same bytes."""
     style_spec: Style = lookup(STYLES, style, "style")
+    reading = lookup(ARROW_READINGS, arrows, "arrow reading")
     size_spec: Size = lookup(SIZES, size, "size")
     level = lookup(SIGNAGE, signage, "signage level")
     if not isinstance(seed, (int, np.integer)) or seed < 0:
@@ -236,7 +254,7 @@ def generate(seed: int, *, style: str = "office", size: str = "medium", signage:
 
     hung = {k: hang(plan, t)[0] for k, t in tags.items()}  # where the check (and the scene) hang them
     facts = Facts(place_positions(hierarchy, hung, params.behind_m), hierarchy, params)
-    world0 = _world(world_name(seed, style, size, signage), plan, tags, layout, goal_roles)
+    world0 = _world(world_name(seed, style, size, signage, arrows), plan, tags, layout, goal_roles)
     oracle = oracle_paths(world0, sorted(goal_roles), params=params.oracle)
 
     # signage: which names each sign carries (seeded apart from the layout so levels share the building)
@@ -252,7 +270,7 @@ def generate(seed: int, *, style: str = "office", size: str = "medium", signage:
     if level.drop_fraction > 0:
         drop = set(srng.permutation(len(junctions))[: round(level.drop_fraction * len(junctions))].tolist())
         junctions = [s for k, s in enumerate(junctions) if k not in drop]
-    writer = Writer(facts, routes, plan, hung, srng)
+    writer = Writer(facts, routes, plan, hung, srng, reading)
     extras_pool = sorted({r.area for r in layout.rooms} | {h.name for h in layout.halls}
                          | {w for w in hierarchy.places if hierarchy.levels()[w] == 3}
                          | {r.name for r in layout.rooms if r.name not in area_only})
@@ -310,12 +328,13 @@ def generate(seed: int, *, style: str = "office", size: str = "medium", signage:
         del tags[sign.tag_id]
     misleading = [m for m in misleading if m["tag"] in tags]
 
-    name = world_name(seed, style, size, signage)
+    name = world_name(seed, style, size, signage, arrows)
     goal_tags = {g: next(t.id for t in tags.values() if t.kind == "label" and t.text == g) for g in goals}
     meta = {
         "format": FORMAT,
         "name": name,
-        "title": f"{style_spec.building} ({style}, {size}, {signage} signage, seed {seed})",
+        "title": f"{style_spec.building} ({style}, {size}, {signage} signage"
+                 f"{'' if arrows == DEFAULT_ARROWS else f', {arrows} arrows'}, seed {seed})",
         "floorplan": {"image": "floorplan.png", "resolution_m": RESOLUTION_M, "origin_m": [0.0, 0.0],
                       "occupied_thresh": 0.65, "free_thresh": 0.2, "negate": False},
         "tags": "tags.json",
@@ -328,6 +347,8 @@ def generate(seed: int, *, style: str = "office", size: str = "medium", signage:
         "generator": {"seed": int(seed), "style": style, "size": size, "signage": signage,
                       "goal_roles": goal_roles, "misleading": misleading},
     }
+    if arrows != DEFAULT_ARROWS:  # written only when not the default, so every earlier world keeps its bytes
+        meta["generator"]["arrows"] = arrows
     tag_list = [tags[k].to_dict() for k in sorted(tags)]
     for entry in tag_list:
         entry["theta_deg"] = round(entry["theta_deg"], 4)
@@ -342,7 +363,7 @@ def generate(seed: int, *, style: str = "office", size: str = "medium", signage:
     world = _world(name, plan, final_tags, layout, goal_roles, goal_tags=goal_tags, oracle_m=meta["oracle_m"],
                    generator=meta["generator"], title=meta["title"])
     return GeneratedWorld(name, int(seed), style, size, signage, files, world, hierarchy, layout, goal_roles,
-                          misleading)
+                          misleading, arrows)
 
 
 def _passes(path: np.ndarray, layout: Layout, node: tuple[int, int]) -> bool:
@@ -420,12 +441,12 @@ def write_world(generated: GeneratedWorld, out_dir: Path) -> Path:
 
 
 def generated_world(seed: int, *, style: str = "office", size: str = "medium", signage: str = "complete",
-                    root: Path) -> Path:
-    """The folder ``root/gen-STYLE-SIZE-SIGNAGE-SEED``, generated and written if not already there."""
-    folder = Path(root) / world_name(seed, style, size, signage)
+                    arrows: str = DEFAULT_ARROWS, root: Path) -> Path:
+    """The folder ``root/<world_name>``, generated and written if not already there."""
+    folder = Path(root) / world_name(seed, style, size, signage, arrows)
     if (folder / "world.json").is_file():
         return folder
-    return write_world(generate(seed, style=style, size=size, signage=signage), folder)
+    return write_world(generate(seed, style=style, size=size, signage=signage, arrows=arrows), folder)
 
 
 __all__ = ["GeneratedWorld", "generate", "write_world", "generated_world", "world_name"]

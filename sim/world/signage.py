@@ -23,7 +23,18 @@ from abstract_map.hierarchy import Hierarchy
 from abstract_map.prepositions import PREPOSITIONS
 from sim.world.data import Floorplan, Tag
 from sim.world.layout import TAG_FRONT_M, Layout, Node
-from sim.world.truth import Facts, RouteField, Routes, first_leg, hang, nearest_arrow, phrase_verdict, place_tags
+from sim.world.truth import (
+    ARROW_READINGS,
+    DEFAULT_ARROWS,
+    ArrowReading,
+    Facts,
+    RouteField,
+    Routes,
+    hang,
+    nearest_arrow,
+    phrase_verdict,
+    place_tags,
+)
 
 SLACK = 0.7  # the generator writes phrases true with 70 % of the check's tolerance
 ARROW_SLACK = 40.0 / 45.0  # and arrows within 40 of the 45 degrees (routes are recomputed exactly by the check)
@@ -171,6 +182,7 @@ class Writer:
     plan: Floorplan
     tags: dict[int, Tag]  # the labels, where they hang
     rng: np.random.Generator
+    reading: ArrowReading = ARROW_READINGS[DEFAULT_ARROWS]  # what an arrow points along (``truth.ARROW_READINGS``)
     used_rows: dict[str, int] = field(default_factory=lambda: {r: 0 for r in PHRASE_ROWS})
     used_words: dict[str, int] = field(default_factory=dict)
     _fields: dict[tuple[float, float, float], RouteField | None] = field(default_factory=dict)
@@ -192,7 +204,8 @@ class Writer:
                 skipped.append(name)
                 continue
             path = field_.route_to(place_tags(name, self.hierarchy, self.tags))
-            leg = None if path is None else first_leg(path, self.facts.positions.get(name), self.routes.params)
+            leg = None if path is None else self.reading.direction(path, self.facts.positions.get(name),
+                                                                    self.routes.params)
             if leg is None:
                 skipped.append(name)
                 continue

@@ -33,6 +33,14 @@ next; a route shorter than ``min_leg_m`` (the label is readable from where the
 reader stands) has as its first leg the line to the place's position. An arrow
 is true when its direction (``prepositions.ARROWS`` added to the sign's facing)
 is within ``tolerance_deg`` of the first leg.
+
+That is how a building's wayfinding signs point: the way to set off. A
+fingerpost (a park's, a zoo's, a campus's outdoor signs) points at the place
+itself, as the crow flies. ``ARROW_READINGS`` holds both: ``way`` (the first
+leg, the default) and ``bearing`` (the line from the reader to the place's
+position; the place must still be reachable). A generated world records the
+one its signs were written by (world.json's ``generator.arrows``, only when
+it is not ``way``), and the check tests its arrows by that one.
 """
 
 from __future__ import annotations
@@ -389,3 +397,26 @@ def place_tags(name: str, hierarchy: Hierarchy, tags: Mapping[int, Tag]) -> list
         grew = bool(more)
         inside |= more
     return [t for t in tags.values() if t.kind == "label" and t.text in inside]
+
+
+def bearing(path: np.ndarray, target: np.ndarray | None, params: TruthParams) -> float | None:
+    """Direction (rad) from a route's start (the reader) to the place's position ``target``; None without one."""
+    if target is None:
+        return None
+    d = np.asarray(target) - path[0]
+    return math.atan2(d[1], d[0]) if np.hypot(*d) > 1e-6 else None
+
+
+@dataclass(frozen=True)
+class ArrowReading:
+    """What a sign's arrow points along, given the reader's route to the place and the place's position."""
+
+    describes: str  # the direction's name in the check's findings
+    direction: Callable[[np.ndarray, np.ndarray | None, TruthParams], float | None]  # (route (N, 2) m, place m) -> rad
+
+
+ARROW_READINGS: dict[str, ArrowReading] = {
+    "way": ArrowReading("the route's first leg", first_leg),  # wayfinding signs in a building: the way to set off
+    "bearing": ArrowReading("the place's bearing", bearing),  # fingerposts: the place as the crow flies
+}
+DEFAULT_ARROWS = "way"  # what a world that declares nothing (the zoo, a hand-made world) is checked by

@@ -38,7 +38,9 @@ def test_fixed_options_and_the_other_cycles():
                                                                      (9, "hospital", "small")]
     assert {g.signage for g in spec.generated()} == set(SIGNAGE)
     one = parse_world_spec("generated:5:signage=sparse")
-    assert [(g.seed, g.signage) for g in one.generated()] == [(5, "sparse")]
+    assert [(g.seed, g.signage, g.arrows) for g in one.generated()] == [(5, "sparse", "way")]
+    posts = parse_world_spec("generated:5-6:style=park,arrows=bearing").generated()
+    assert [(g.seed, g.style, g.arrows) for g in posts] == [(5, "park", "bearing"), (6, "park", "bearing")]
 
 
 @pytest.mark.parametrize("text, words", [
@@ -47,6 +49,7 @@ def test_fixed_options_and_the_other_cycles():
     ("generated:1-2:colour=red", "option 'colour=red'"),
     ("generated:1-2:style=castle", "style 'castle'"),
     ("generated:1-2:style=office,style=museum", "given twice"),
+    ("generated:1-2:arrows=crow", "arrows 'crow'"),
     ("generated:0-99999", "at most"),
     ("generated:a-b", "expected seeds"),
     ("", "empty"),

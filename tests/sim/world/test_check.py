@@ -106,6 +106,23 @@ def test_a_false_phrase_fails(generated, folder):
     assert len(found) == 1 and found[0].subject == f"tag {sign.id}" and false[0] in found[0].message
 
 
+def test_fingerposts_are_checked_by_the_bearing_their_world_declares(tmp_path):
+    """A world generated with bearing arrows passes its own check; read as wayfinding signs (its declaration
+    removed) some of its arrows fail against their routes' first legs, and an unknown declaration is a finding
+    naming it."""
+    posts = write_world(generate(SEED, style="office", size="small", arrows="bearing"), tmp_path / "posts")
+    assert check_world(load_world(posts)).ok
+    meta = json.loads((posts / "world.json").read_text())
+    for value, expect in ((None, "first leg"), ("crow", "generator.arrows 'crow'")):
+        if value is None:
+            del meta["generator"]["arrows"]
+        else:
+            meta["generator"]["arrows"] = value
+        (posts / "world.json").write_text(json.dumps(meta))
+        found = [f for f in failing(posts) if f.kind == "arrow"]
+        assert found and any(expect in f.message for f in found), value
+
+
 def test_every_arrow_is_checked_against_its_route(generated):
     report = check_world(generated.world, hierarchy=generated.hierarchy)
     arrows = sum(isinstance(c, Locational) and c.kind == "arrow"

@@ -153,6 +153,27 @@ def test_the_park_is_open_ground_and_its_arrows_point_nearer_their_places():
     assert not park.layout.halls and (park.layout.raster() > 0).mean() > (office.layout.raster() > 0).mean()
 
 
+def test_fingerposts_point_at_their_places_in_the_same_building_and_pass_their_own_check():
+    """``arrows="bearing"``: every arrow within 45 degrees of the bearing from its reader to its place, where
+    wayfinding arrows in the same office point the way and so miss their places far more often; the plan, the
+    labels and the goals are the way-signed building's, the world says which reading it was written by, and
+    the default's bytes carry no word of it."""
+    from sim.world.truth import DEFAULT_ARROWS
+
+    way, posts = made(2, "office", "medium"), generate(2, style="office", size="medium", arrows="bearing")
+    assert posts.files["floorplan.png"] == way.files["floorplan.png"] and posts.world.goals == way.world.goals
+    assert posts.name == "gen-office-medium-complete-bearing-2" and posts.arrows == "bearing"
+    assert posts.world.generator["arrows"] == "bearing" and b'"arrows"' not in way.files["world.json"]
+    assert way.arrows == DEFAULT_ARROWS and world_name(2, "office", "medium", "complete") == way.name
+    report = posts.check()
+    assert report.ok and report.checked["arrows"] > 0
+    within = {name: float(np.mean(np.array(arrow_offsets_deg(g)) <= 45.0)) for name, g in (("way", way),
+                                                                                            ("posts", posts))}
+    assert within["posts"] > 0.9 > within["way"] + 0.2
+    with pytest.raises(ValueError, match="arrow reading 'crow'"):
+        generate(2, style="office", size="small", arrows="crow")
+
+
 def test_wide_paths_leave_a_block_and_a_sign_with_few_places_near_it_skips_between():
     """Small parks once drew paths wider than their lattice cells (seeds 2 and 3 crashed), and a sign with only
     two places near it once asked for a "between" of three (medium park seed 14 crashed)."""
