@@ -160,7 +160,13 @@ def test_command_exit_codes(generated, folder, tmp_path, capsys):
     out = tmp_path / "new"
     assert cli.main(["world", "generate", "--seed", str(SEED), "--size", "small", "--out", str(out)]) == 0
     assert (out / "world.json").read_bytes() == generated.files["world.json"]
+    posts = tmp_path / "posts"
+    assert cli.main(["world", "generate", "--seed", str(SEED), "--size", "small", "--arrows", "bearing",
+                     "--out", str(posts)]) == 0
+    assert json.loads((posts / "world.json").read_text())["generator"]["arrows"] == "bearing"
+    assert cli.main(["world", "check", str(posts)]) == 0
     for bad in (["--seed", "x"], ["--seed", "1", "--style", "castle"], ["--seed", "1", "--size", "huge"],
+                ["--seed", "1", "--arrows", "crow"],
                 ["--seed", "2", "--size", "small"]):  # the last: out holds another world
         capsys.readouterr()
         assert cli.main(["world", "generate", *bad, "--out", str(out)]) == 2
