@@ -298,11 +298,12 @@ class GeneraliseSuite:
     max_sim_s: float = 600.0  # s of simulated time per trial: 4.8x the longest oracle's drive at full speed
     style: str | None = None  # None: styles cycle with the seed (the test split); a name fixes every building's,
     # e.g. "park", which is outside the cycle
+    arrows: str = "way"  # what the signs' arrows point along: "way" (the test split) or "bearing" (fingerposts)
 
     def worlds(self, count: int) -> str:
         """The ``--world`` spec of the first ``count`` test buildings."""
-        spec = f"generated:{TEST_SEED}-{TEST_SEED + count - 1}"
-        return f"{spec}:style={self.style}" if self.style else spec
+        options = [f"style={self.style}"] * bool(self.style) + [f"arrows={self.arrows}"] * (self.arrows != "way")
+        return f"generated:{TEST_SEED}-{TEST_SEED + count - 1}" + (":" + ",".join(options) if options else "")
 
 
 def bench_generalise(suite: GeneraliseSuite = GeneraliseSuite(), workers: int = 2,
@@ -410,6 +411,8 @@ def main() -> int:
                         help=f"generalise: cap on each trial's simulated seconds (default {suite.max_sim_s:.0f})")
     parser.add_argument("--style", default=None,
                         help="generalise: one style for every building, e.g. park (default: styles cycle)")
+    parser.add_argument("--arrows", default="way", help="generalise: what the signs' arrows point along, way "
+                                                        "(default: the test split) or bearing (fingerposts)")
     parser.add_argument("--workers", type=int, default=2, help="generalise: parallel trials (default 2)")
     parser.add_argument("--out", type=Path, default=ROOT / "runs" / "generalise",
                         help="generalise: study folder, re-used to resume (default runs/generalise)")
@@ -427,13 +430,16 @@ def main() -> int:
         parser.error("--buildings must be 1-1000, --camera-buildings 0 to --buildings, --workers at least 1, "
                      "--max-sim-s 1 to 1000000")
     from sim.world.styles import STYLES
+    from sim.world.truth import ARROW_READINGS
 
     if args.style is not None and args.style not in STYLES:
         parser.error(f"--style {args.style!r}: expected one of {', '.join(STYLES)}")
+    if args.arrows not in ARROW_READINGS:
+        parser.error(f"--arrows {args.arrows!r}: expected one of {', '.join(ARROW_READINGS)}")
     for name in args.which or BENCHMARKS:
         if name == "generalise":
             chosen = replace(suite, buildings=args.buildings, camera_buildings=args.camera_buildings,
-                             max_sim_s=args.max_sim_s, style=args.style)
+                             max_sim_s=args.max_sim_s, style=args.style, arrows=args.arrows)
             bench_generalise(chosen, args.workers, args.out, args.report_only)
         elif name == "settle":
             bench_settle(args.against)

@@ -48,3 +48,15 @@ def test_a_style_fixes_every_building_and_an_unknown_one_is_refused(monkeypatch,
         run.main()
     assert exit_.value.code == 2
     assert "--style 'castle': expected one of office, hospital, museum, campus, park" in capsys.readouterr().err
+
+
+def test_fingerposts_run_the_same_buildings_and_an_unknown_reading_is_refused(monkeypatch, capsys):
+    run = _benchmarks(monkeypatch)
+    assert run.GeneraliseSuite(arrows="bearing").worlds(30) == "generated:1000-1029:arrows=bearing"
+    park = run.GeneraliseSuite(style="park", arrows="bearing")
+    assert park.worlds(2) == "generated:1000-1001:style=park,arrows=bearing"
+    monkeypatch.setattr(sys, "argv", ["run.py", "generalise", "--arrows", "crow"])
+    with pytest.raises(SystemExit) as exit_:
+        run.main()
+    assert exit_.value.code == 2
+    assert "--arrows 'crow': expected one of way, bearing" in capsys.readouterr().err
