@@ -23,6 +23,7 @@ See ``docs/method-notes.md`` (negative information) for the equations.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -225,6 +226,24 @@ class GoalPrior:
     # sharing the goal's parent area (none when that parent is the hierarchy's root)
 
 
+@dataclass(frozen=True)
+class MixedPrior:
+    """Goal priors held at once, each with the chance it is the right one: ``parts`` of (weight, prior), the
+    weights summing to 1. Each part is spread over the grid as a whole before it is weighted, so a part that
+    lies even over the building counts as much as one gathered in a corner. ``centre`` and ``sigma_m`` are the
+    first part's (the abstract map's own)."""
+
+    parts: tuple[tuple[float, GoalPrior], ...]
+
+    @property
+    def centre(self) -> np.ndarray:
+        return self.parts[0][1].centre
+
+    @property
+    def sigma_m(self) -> float:
+        return self.parts[0][1].sigma_m
+
+
 def prior_components(prior: GoalPrior, params: BeliefParams) -> list[tuple[float, np.ndarray, float]]:
     """The prior's core as Gaussian components (weight, centre m, spread m), weights summing to 1.
 
@@ -304,21 +323,9 @@ def labels_near_places(density: np.ndarray, wall: np.ndarray, reach_cells: float
     return wall * np.repeat(np.repeat(spread, k, axis=0), k, axis=1)[:wall.shape[0], :wall.shape[1]]
 
 
-def goal_belief(grid: OccupancyGrid, swept: np.ndarray, prior: GoalPrior, params: BeliefParams,
-                evidence: np.ndarray | None = None) -> Belief:
-    """Posterior over the label's cell: the place's prior x evidence, handed to the wall near each place
-    (:func:`labels_near_places`), x (1 - detect_prob on swept cells).
-
-    The place's prior is :func:`prior_components` (the imagined goal mixed with
-    its siblings' labels) mixed with a wide tail about the imagined goal
-    (``tail_weight``, ``tail_scale`` times its spread). ``evidence`` (the grid's
-    shape, e.g. :func:`sim.navigation.routes.route_likelihood` of the arrows
-    read) multiplies it.
-
-    ``remaining`` is the posterior's normaliser against the prior's (both with
-    each cell's wall chance): the share of the prior on wall not yet swept, near
-    1 when nothing near the goal has been looked at, near 0 when it all has.
-    """
+def place_density(grid: OccupancyGrid, prior: GoalPrior, params: BeliefParams) -> np.ndarray:
+    """Per grid cell, the place's prior density (1 / m^2): :func:`prior_components` mixed with a wide tail about
+    the imagined goal (``tail_weight``, ``tail_scale`` times its spread)."""
     centre = np.asarray(prior.centre, dtype=float)
     xy_col, xy_row = grid.cell_axes()
     components = [((1.0 - params.tail_weight) * w, c, s) for w, c, s in prior_components(prior, params)]
@@ -328,15 +335,45 @@ def goal_belief(grid: OccupancyGrid, swept: np.ndarray, prior: GoalPrior, params
         gx = np.exp(-0.5 * ((xy_col - mean[0]) / spread) ** 2)
         gy = np.exp(-0.5 * ((xy_row - mean[1]) / spread) ** 2)
         density += weight / spread ** 2 * np.outer(gy, gx)
-    if evidence is not None:
-        density *= evidence
+    return density
+
+
+def goal_belief(grid: OccupancyGrid, swept: np.ndarray, prior: GoalPrior | MixedPrior, params: BeliefParams,
+                evidence: np.ndarray | None = None) -> Belief:
+    """Posterior over the label's cell: the place's prior x evidence, handed to the wall near each place
+    (:func:`labels_near_places`), x (1 - detect_prob on swept cells).
+
+    The place's prior is :func:`place_density` (the imagined goal mixed with
+    its siblings' labels and a wide tail), or for a :class:`MixedPrior` its
+    parts', each made to sum to 1 over the grid and weighted. ``evidence`` (the grid's
+    shape, e.g. :func:`sim.navigation.routes.route_likelihood` of the arrows
+    read) multiplies it.
+
+    ``remaining`` is the posterior's normaliser against the prior's (both with
+    each cell's wall chance): the share of the prior on wall not yet swept, near
+    1 when nothing near the goal has been looked at, near 0 when it all has; for
+    a :class:`MixedPrior`, of its first part's (the model's own: whether the
+    label is where the model imagines it).
+    """
+    centre = np.asarray(prior.centre, dtype=float)
+    parts = ((1.0, prior),) if isinstance(prior, GoalPrior) else prior.parts
     wall = wall_chance(grid.occupied_mask(), grid.free_mask(), params)
-    weighted = labels_near_places(density, wall, params.label_offset_m / grid.resolution)
-    posterior = weighted * np.where(swept, 1.0 - params.detect_prob, 1.0)
-    reference = float(weighted.sum())
+    unswept = np.where(swept, 1.0 - params.detect_prob, 1.0)
+    shares = []  # per part: its weighted prior on the walls, and that share not yet swept
+    for weight, part in parts:
+        density = place_density(grid, part, params) if weight > 0 else np.zeros(grid.shape)
+        if len(parts) > 1:
+            total = float(density.sum())
+            density = weight / total * density if total > 0 else np.zeros(grid.shape)
+        if evidence is not None:
+            density = density * evidence
+        weighted = labels_near_places(density, wall, params.label_offset_m / grid.resolution)
+        shares.append((weighted, weighted * unswept))
+    posterior = functools.reduce(np.add, (p for _, p in shares))
     total = float(posterior.sum())
     mass = posterior / total if total > 0 else posterior
-    remaining = min(1.0, total / reference) if reference > 0 else 0.0
+    own_reference, own_left = float(shares[0][0].sum()), float(shares[0][1].sum())
+    remaining = min(1.0, own_left / own_reference) if own_reference > 0 else 0.0
     return Belief(mass.astype(np.float32), remaining, (float(centre[0]), float(centre[1])),
                   float(prior.sigma_m))
 

@@ -38,6 +38,7 @@ import numpy as np
 from scipy import ndimage
 
 from sim.mapping.occupancy import OccupancyGrid, pool_cells, unpool_cells
+from sim.navigation.fingerposts import PostParams
 from sim.navigation.routes import PathSearches, RouteParams, follow_pointers, open_cell, route_cells
 
 WALL_CELLS = 1e4  # route cost of a wall cell, in open cells: more than any route through open space
@@ -66,6 +67,8 @@ class GuideParams:
     # way the cues name the goal (``BeliefParams.floor_m``): far beyond any building, so the prior lies even over
     # the map (the model's misses average it down slowly: to about 300 m after 30 labels read) until labels of the
     # goal's siblings are read, which then hold it
+    posts: PostParams = PostParams()  # the fingerpost test: how much of the goal's prior the model's point holds
+    # (the rest lies as ``even-prior``'s does); ``PostParams(prior=1.0)`` is the paper's reading throughout
     known_front_m: float = 1.5  # m in front of the goal's label the ``known-pose`` reference drives to: past the
     # camera's 1 m near limit and well inside the 4 m reading range
     known_spread_m: float = 1.0  # m, the ``known-goal`` baseline's prior about the goal's true label: the label to

@@ -47,7 +47,17 @@ import numpy as np
 from abstract_map.clauses import Clause, Locational, clause_names, is_anchor, named_by
 from abstract_map.model import SettleReport, imagined_positions
 from sim.mapping.occupancy import OccupancyGrid
-from sim.navigation.belief import Belief, BeliefParams, GoalPrior, SweptSpace, cue_mass, goal_belief, goal_sigma
+from sim.navigation.belief import (
+    Belief,
+    BeliefParams,
+    GoalPrior,
+    MixedPrior,
+    SweptSpace,
+    cue_mass,
+    goal_belief,
+    goal_sigma,
+)
+from sim.navigation.fingerposts import PostTest
 from sim.navigation.follower import (
     FollowerParams,
     PathFollower,
@@ -334,10 +344,15 @@ class AbstractMapPolicy(Driven):
         of the signs read that name neither the goal nor an area holding it. A factor with nothing to say (no
         such arrow or sign read) is left out; door depth is always there."""
         makers = {"doors": lambda: door_depth_weight(grid, self.start[:2], routes, searches),
-                  "arrows": lambda: route_likelihood(grid, self.arrows(), routes, searches),
+                  "arrows": lambda: route_likelihood(grid, self.arrows(), routes, searches, self.bearing_share()),
                   "unnamed signs": lambda: passed_likelihood(grid, self.unnamed(), self.start[:2], routes, searches)}
         found = {name: makers[name]() for name in names}
         return {name: factor for name, factor in found.items() if factor is not None}
+
+    def bearing_share(self) -> float:
+        """The chance this building's arrows point at their places (fingerposts) rather than the way: 0, the
+        route reading, unless a policy tests it (:class:`GuidedPolicy`)."""
+        return 0.0
 
     @property
     def depth(self) -> np.ndarray:
@@ -349,7 +364,7 @@ class AbstractMapPolicy(Driven):
         cell; refreshed when a new sign is read or every ``evidence_every_s`` (walls and doors are mapped
         slowly)."""
         arrows, unnamed = self.arrows(), self.unnamed()
-        key = (*arrows, *unnamed)
+        key = (*arrows, *unnamed, self.bearing_share())
         if self.evidence is None or key != self.evidence_key or self.now - self.evidence_at >= \
                 self.params.routes.evidence_every_s:
             self.factors = self.evidence_factors(grid, self.params.routes, self.searches)
@@ -587,9 +602,17 @@ class GuidedPolicy(AbstractMapPolicy):
     grows a step at a time (:meth:`fed_back_belief`), so the prior moves on from
     where the label has been looked for. The search is complete: it ends when
     the goal's label is read or no frontier is left.
+
+    How far the abstract map's point is followed, and how the arrows are read,
+    is decided by the building's own signs (:mod:`sim.navigation.fingerposts`):
+    with the chance ``c`` that its arrows point at their places (fingerposts, as
+    the paper reads them), the prior is ``c`` of the model's and ``1 - c`` of
+    ``even-prior``'s (a :class:`~sim.navigation.belief.MixedPrior`), and each
+    arrow's likelihood ``c`` of a bearing's and ``1 - c`` of a route's first leg.
     """
 
     feeds_back = True  # grows the abstract map when the belief is used up (False: a prior that is not the model's)
+    tests_posts = True  # weighs the model's point and the arrows' reading by the fingerpost test (False: neither)
     spots = True  # takes in the plates seen but unread (``observe(..., spotted=...)``); other policies ignore them
 
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
@@ -607,6 +630,7 @@ class GuidedPolicy(AbstractMapPolicy):
         self.zones_version = -1
         self.stop: Spot | None = None  # the unread plate the robot is stepping in front of before its door
         self.door_asked: tuple | None = None  # (plan, plates' version, target) of the latest door_stop check
+        self.posts = PostTest(params.guide.posts)  # whether this building's arrows point at their places
 
     def forget_target(self) -> None:
         self.search.target = None
@@ -621,11 +645,40 @@ class GuidedPolicy(AbstractMapPolicy):
         """Per grid cell, the goal belief behind it (:func:`sim.navigation.gateways.frontier_values`), and in
         front of each plate seen but unread, the belief on that plate."""
         plates, read = self.tags.tag_cells(grid), self.tags.read_cells(grid)
+        self.posts.judge(grid, self._signs_read())
         self.belief_swept = (self._looked_or_seen(covered) & ~plates) | read
         self.belief = self.fed_back_belief(grid, self.belief_swept,
                                            self.params.guide.exhausted_remaining if self.feeds_back else 0.0)
         values = frontier_values(grid, self.belief.mass, covered, robot_xy, self.params.guide, self.params.routes)
         return np.maximum(values, self.tags.zone_values(grid, self.belief.mass))
+
+    def goal_prior(self, belief: BeliefParams | None = None) -> GoalPrior | MixedPrior:
+        """The abstract map's prior (:meth:`AbstractMapPolicy.goal_prior`) as far as the fingerpost test
+        (:mod:`sim.navigation.fingerposts`) says this building's arrows point at their places; the rest of the
+        chance lies as ``even-prior``'s prior does, even over the map until the goal's siblings are read."""
+        own = super().goal_prior(belief)
+        chance = self.posts.chance if self.tests_posts else 1.0
+        if chance >= 1.0:
+            return own
+        return MixedPrior(((chance, own), (1.0 - chance, super().goal_prior(self.even_params(belief)))))
+
+    def bearing_share(self) -> float:
+        return self.posts.chance if self.tests_posts else 0.0
+
+    def even_params(self, belief: BeliefParams | None = None) -> BeliefParams:
+        """``belief`` (or the policy's own) with every floor of the prior's spread at ``even_spread_m``."""
+        spread = self.params.guide.even_spread_m
+        return replace(belief or self.params.belief, sigma_min_m=spread, sigma_min_arrow_m=spread,
+                       sigma_min_hierarchy_m=spread)
+
+    def _signs_read(self) -> Iterable[tuple[str, tuple[float, float], float, list[float]]]:
+        """Each sign read with an arrow: its anchor, position (m), facing (rad) and arrows' directions (rad)."""
+        model = self.nav.model
+        for anchor, clauses in model.cue_clauses.items():
+            sign = model.fixed.get(anchor)
+            directions = [c.direction for c in clauses if isinstance(c, Locational) and c.kind == "arrow"]
+            if sign is not None and directions:
+                yield anchor, (sign.x, sign.y), sign.theta, directions
 
     def command(self, t_s: float, pose: Pose, grid: OccupancyGrid, tick_s: float,
                 rng: np.random.Generator) -> tuple[float, float]:
@@ -718,11 +771,10 @@ class EvenPriorPolicy(GuidedPolicy):
     would be worth on the test split").
     """
 
+    tests_posts = False  # the ablation: no point, arrows read as ways
+
     def goal_prior(self, belief: BeliefParams | None = None) -> GoalPrior:
-        spread = self.params.guide.even_spread_m
-        even = replace(belief or self.params.belief, sigma_min_m=spread, sigma_min_arrow_m=spread,
-                       sigma_min_hierarchy_m=spread)
-        return super().goal_prior(even)
+        return AbstractMapPolicy.goal_prior(self, self.even_params(belief))
 
 
 class KnownGoalPolicy(GuidedPolicy):
@@ -738,6 +790,7 @@ class KnownGoalPolicy(GuidedPolicy):
     """
 
     feeds_back = False  # its prior sits on the label, not on the abstract map: growing the model moves nothing
+    tests_posts = False  # an informed reference: its arrows read as ``even-prior``'s and main's were
 
     def __init__(self, world: World, goal: str, start: Pose, params: PolicyParams) -> None:
         super().__init__(world, goal, start, params)

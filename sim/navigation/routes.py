@@ -183,9 +183,12 @@ def open_cell(grid: OccupancyGrid, pool: int, blocked: np.ndarray, xy: np.ndarra
 
 
 def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: RouteParams = RouteParams(),
-                     searches: PathSearches | None = None) -> np.ndarray | None:
+                     searches: PathSearches | None = None, bearing_share: float = 0.0) -> np.ndarray | None:
     """The product over ``arrows`` of each one's likelihood, per cell of ``grid`` (float, max 1); None if none.
-    ``searches``: path searches kept from earlier calls (the same answer, sooner)."""
+    ``searches``: path searches kept from earlier calls (the same answer, sooner). ``bearing_share``: the chance
+    the arrows are fingerposts (:mod:`sim.navigation.fingerposts`), pointing at their places as the crow flies:
+    each arrow's ``near`` is then that share of the same falloff of the angle between the arrow and the line from
+    its reader to the cell, and the rest its route's (module docstring)."""
     searches = PathSearches() if searches is None else searches
     arrows = list(arrows)
     if not arrows:
@@ -202,6 +205,10 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
                                                                             math.sin(arrow.facing)]))
         if stand is None:
             continue
+        if bearing_share >= 1.0:
+            total *= arrow.wrong_prob + (1.0 - arrow.wrong_prob) * _bearing_near(blocked.shape, stand, arrow.direction,
+                                                                                 tolerance, spread)
+            continue
         lengths, pred = searches.tree("route", costs, stand)
         lead = params.lead_m / step
         leg = first_leg_points(lengths.ravel(), pred, lead)
@@ -215,9 +222,24 @@ def route_likelihood(grid: OccupancyGrid, arrows: Iterable[Arrow], params: Route
                                                 params.unseen_detour, searches, f"leg {arrow}"))
         near[~np.isfinite(lengths)] = 1.0  # cut off from the reader: the arrow says nothing there
         near[stand] = 1.0
+        if bearing_share > 0.0:
+            near = bearing_share * _bearing_near(blocked.shape, stand, arrow.direction, tolerance, spread) \
+                + (1.0 - bearing_share) * near
         total *= arrow.wrong_prob + (1.0 - arrow.wrong_prob) * near
     fine = unpool_cells(walls_take_front(total, blocked, params.front_m / step), pool, grid.shape)
     return fine / float(fine.max())
+
+
+def _bearing_near(shape: tuple[int, int], stand: tuple[int, int], direction: float, tolerance: float,
+                  spread: float) -> np.ndarray:
+    """Per route cell, ``exp(-max(error - tolerance, 0) / spread)`` with ``error`` the angle (rad) between
+    ``direction`` and the line from the reader's cell ``stand`` to the cell (1 at the reader)."""
+    rows, cols = np.indices(shape)
+    heading = np.arctan2(-(rows - stand[0]), cols - stand[1])  # rows run down the map: y is -row
+    error = np.abs(np.angle(np.exp(1j * (heading - direction))))
+    near = np.exp(-np.maximum(error - tolerance, 0.0) / spread)
+    near[stand] = 1.0
+    return near
 
 
 def _unseen_way(lengths: np.ndarray, pred: np.ndarray, along: np.ndarray, costs: np.ndarray, unseen: np.ndarray,

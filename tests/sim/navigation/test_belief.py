@@ -9,6 +9,7 @@ from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
 from sim.navigation.belief import (
     BeliefParams,
     GoalPrior,
+    MixedPrior,
     SweptSpace,
     cue_mass,
     goal_belief,
@@ -149,6 +150,24 @@ def test_belief_moves_to_where_siblings_were_read():
     bottom = wall_cells_at(grid, 1.0)
     assert family.mass[top].sum() > alone.mass[top].sum()
     assert family.mass[bottom].sum() < alone.mass[bottom].sum()
+
+
+def test_a_mixed_prior_weighs_each_part_as_a_whole_over_the_grid():
+    """A part of weight 1 is the plain prior; a narrow prior at the wall's south end mixed half and half with
+    one a kilometre wide puts on the north half of the wall the mean of what each alone puts there, although
+    the wide one's density is a million times thinner."""
+    grid, params = corridor(), BeliefParams()
+    swept = np.zeros(grid.shape, dtype=bool)
+    narrow, even = GoalPrior(np.array([7.0, 0.0]), 2.0), GoalPrior(np.array([7.0, 0.0]), 1000.0)
+    alone = goal_belief(grid, swept, narrow, params)
+    assert np.allclose(goal_belief(grid, swept, MixedPrior(((1.0, narrow), (0.0, even))), params).mass, alone.mass)
+    mixed = goal_belief(grid, swept, MixedPrior(((0.5, narrow), (0.5, even))), params)
+    north = grid.world_to_cell(np.array([[WALL_X, 4.0]]))[0, 0]  # rows above this lie north
+    spread = goal_belief(grid, swept, even, params)
+    assert alone.mass[:north].sum() < 0.25 < 0.45 < spread.mass[:north].sum()
+    assert mixed.mass[:north].sum() == pytest.approx((alone.mass[:north].sum() + spread.mass[:north].sum()) / 2,
+                                                     abs=0.02)
+    assert mixed.centre == alone.centre and mixed.sigma_m == alone.sigma_m
 
 
 def test_a_places_share_goes_to_the_wall_about_it():

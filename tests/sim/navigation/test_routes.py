@@ -18,6 +18,7 @@ from sim.navigation.routes import (
     route_likelihood,
     walls_take_front,
 )
+from tests.mapped_grid import mapped
 
 
 def grid_of(walls: list[tuple[float, float, float, float]], size: tuple[float, float] = (20.0, 12.0)
@@ -75,6 +76,23 @@ def test_route_likelihood_follows_a_corridor_round_its_corner():
     assert at(grid, route_likelihood(grid, [west]), *north_room) < 0.15
 
 
+def test_a_fingerpost_points_through_the_wall_at_its_place_and_a_share_of_it_mixes_the_two_readings():
+    """The corridor round its corner again: read as a fingerpost (``bearing_share`` 1) the arrow west points at
+    the room straight across the wall's west end, and the arrow east no longer leads round the corner to it;
+    ``bearing_share`` 0 is the route reading itself, and a half share lies between the two."""
+    grid = grid_of([(0.0, 16.0, 4.0, 4.2)])
+    west = Arrow(sign_xy=(4.0, 1.0), facing=math.pi / 2, direction=math.pi * 0.75, wrong_prob=0.1)
+    north_west_room = (1.0, 6.0)  # 3 m west and 4 m north of the reader, behind the wall
+    route = route_likelihood(grid, [west])
+    assert np.array_equal(route_likelihood(grid, [west], bearing_share=0.0), route)
+    post = route_likelihood(grid, [west], bearing_share=1.0)
+    half = route_likelihood(grid, [west], bearing_share=0.5)
+    assert at(grid, route, *north_west_room) < 0.3 < 0.9 < at(grid, post, *north_west_room)
+    assert at(grid, route, *north_west_room) < at(grid, half, *north_west_room) < at(grid, post, *north_west_room)
+    east = Arrow(sign_xy=(4.0, 1.0), facing=math.pi / 2, direction=0.0, wrong_prob=0.1)
+    assert at(grid, route_likelihood(grid, [east], bearing_share=1.0), 2.0, 8.0) < 0.15
+
+
 def test_a_room_behind_a_door_weighs_less_than_the_corridor_it_opens_on():
     """A 2 m corridor (y 0 .. 2) and a room above it (y 2.2 .. 8) entered by a 1 m door at x 9.5 .. 10.5."""
     walls = [(0.0, 9.5, 2.0, 2.2), (10.5, 20.0, 2.0, 2.2)]
@@ -106,22 +124,6 @@ def test_kept_path_searches_give_the_same_evidence_and_run_again_only_on_a_chang
     plain = next(key for key in found if key[0] == "plain")
     assert searches.found[plain] is not found[plain]  # run again on the changed map
     assert searches.found.keys() >= {key for key in found if key[0] == "route"}  # kept: only depth was asked
-
-
-def mapped(world) -> OccupancyGrid:
-    """A grid over ``world`` with every cell mapped as its floor plan has it."""
-    x0, x1, y0, y1 = world.floorplan.extent
-    grid = OccupancyGrid(OccupancyParams(resolution_m=0.1, bounds=(x0, x1, y0, y1)))
-    xy = grid.cell_to_world(np.argwhere(np.ones(grid.shape, dtype=bool)))
-    plan = world.floorplan
-    col = ((xy[:, 0] - plan.origin[0]) / plan.resolution).astype(int)
-    row = plan.shape[0] - 1 - ((xy[:, 1] - plan.origin[1]) / plan.resolution).astype(int)
-    inside = (row >= 0) & (row < plan.shape[0]) & (col >= 0) & (col < plan.shape[1])
-    occupied = np.zeros(len(xy), dtype=bool)
-    occupied[inside] = plan.occupied[row[inside], col[inside]]
-    cells = grid.world_to_cell(xy)
-    grid.log_odds[cells[:, 0], cells[:, 1]] = np.where(occupied, 3.0, -2.0)
-    return grid
 
 
 @pytest.mark.parametrize("style", ["office", "museum"])
