@@ -67,8 +67,9 @@ class GuideParams:
     # way the cues name the goal (``BeliefParams.floor_m``): far beyond any building, so the prior lies even over
     # the map (the model's misses average it down slowly: to about 300 m after 30 labels read) until labels of the
     # goal's siblings are read, which then hold it
-    posts: PostParams = PostParams()  # the fingerpost test: how much of the goal's prior the model's point holds
-    # (the rest lies as ``even-prior``'s does); ``PostParams(prior=1.0)`` is the paper's reading throughout
+    posts: PostParams = PostParams()  # the fingerpost test (sim/navigation/fingerposts.py): its chance is the share
+    # of the goal's prior the model's point holds (the rest lies as ``even-prior``'s does) and of each arrow's
+    # likelihood its bearing's (the rest its route's); ``PostParams(prior=1.0)`` is the paper's reading throughout
     known_front_m: float = 1.5  # m in front of the goal's label the ``known-pose`` reference drives to: past the
     # camera's 1 m near limit and well inside the 4 m reading range
     known_spread_m: float = 1.0  # m, the ``known-goal`` baseline's prior about the goal's true label: the label to
