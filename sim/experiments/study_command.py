@@ -11,7 +11,8 @@ with keys style (office, hospital, museum, campus, park), size (small, medium, l
 and signage (complete, sparse, misleading). Unless fixed, style and signage cycle with the seed: seed s
 is style number s % 4 of office, hospital, museum, campus and signage level number (s // 4) % 3, so any
 12 consecutive seeds cover every pair (with one fixed, the other cycles by s % its count); the park is
-built only when named (style=park). Generated worlds are written to
+built only when named (style=park). arrows=bearing writes the same buildings' signs as fingerposts, each
+arrow pointing at its place (default arrows=way: the way to set off). Generated worlds are written to
 DIR/worlds/. Seeds 0-999 are for development; 1000-1999 are test buildings, for reporting only.
 
 Trials differ by seed: start-pose jitter (0.10 m, 3 deg), the recovery's turning direction and, in
@@ -41,7 +42,7 @@ EXTRA = "sim"  # the optional dependencies it needs
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--world", action="append", metavar="SPEC",
-                        help="a world name, a world folder or generated:A-B[:style=..,size=..,signage=..]; "
+                        help="a world name, a world folder or generated:A-B[:style=..,size=..,signage=..,arrows=..]; "
                              "repeatable (default: zoo)")
     parser.add_argument("--trials", type=int, default=5, help="trials per goal and navigator (default 5)")
     parser.add_argument("--navigator", action="append", metavar="NAME",
