@@ -370,14 +370,19 @@ class RouteField:
         return self._nearest(tag) is not None
 
 
+def bearing(path: np.ndarray, target: np.ndarray | None, params: TruthParams) -> float | None:
+    """Direction (rad) from a route's start (the reader) to the place's position ``target``; None without one."""
+    if target is None:
+        return None
+    d = np.asarray(target) - path[0]
+    return math.atan2(d[1], d[0]) if np.hypot(*d) > 1e-6 else None
+
+
 def first_leg(path: np.ndarray, target: np.ndarray | None, params: TruthParams) -> float | None:
     """Direction (rad) of a route's first leg (module docstring); None if it has none."""
     length = float(np.hypot(*np.diff(path, axis=0).T).sum()) if len(path) > 1 else 0.0
     if length < params.min_leg_m:
-        if target is None:
-            return None
-        d = np.asarray(target) - path[0]
-        return math.atan2(d[1], d[0]) if np.hypot(*d) > 1e-6 else None
+        return bearing(path, target, params)
     coords = np.asarray(LineString(path).simplify(params.simplify_m).coords)
     end = coords[1]
     for point in coords[1:]:
@@ -397,14 +402,6 @@ def place_tags(name: str, hierarchy: Hierarchy, tags: Mapping[int, Tag]) -> list
         grew = bool(more)
         inside |= more
     return [t for t in tags.values() if t.kind == "label" and t.text in inside]
-
-
-def bearing(path: np.ndarray, target: np.ndarray | None, params: TruthParams) -> float | None:
-    """Direction (rad) from a route's start (the reader) to the place's position ``target``; None without one."""
-    if target is None:
-        return None
-    d = np.asarray(target) - path[0]
-    return math.atan2(d[1], d[0]) if np.hypot(*d) > 1e-6 else None
 
 
 @dataclass(frozen=True)
