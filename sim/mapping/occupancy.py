@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sim.world.data import Floorplan
 from sim.world.pose import check_pose
 
 FREE_GREY = 254  # map_server colours for to_image()
@@ -231,6 +232,21 @@ class OccupancyGrid:
         other.log_odds = self.log_odds.copy()
         other.version = self.version
         return other
+
+
+def mapped_plan(plan: Floorplan, resolution_m: float = 0.1) -> OccupancyGrid:
+    """A grid over ``plan``'s extent mapped as the plan has it: a cell holding any wall pixel occupied (a wall
+    thinner than a cell is mapped, as a laser maps it), every other cell free, at log-odds 3 and -2. The robot's
+    map had it seen the whole building, for measuring on true plans what the navigator reads off its own."""
+    grid = OccupancyGrid(OccupancyParams(resolution_m=resolution_m, bounds=plan.extent))
+    grid.log_odds[:] = -2.0
+    rows, cols = np.nonzero(plan.occupied)
+    x = plan.origin[0] + (cols + 0.5) * plan.resolution
+    y = plan.origin[1] + (plan.shape[0] - rows - 0.5) * plan.resolution
+    cells = grid.world_to_cell(np.stack([x, y], axis=1))
+    inside = grid.in_bounds(cells)
+    grid.log_odds[cells[inside, 0], cells[inside, 1]] = 3.0
+    return grid
 
 
 def pool_cells(values: np.ndarray, factor: int, fill: float | bool, reduce: Callable[..., np.ndarray]) -> np.ndarray:

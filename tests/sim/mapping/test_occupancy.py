@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
+from sim.mapping.occupancy import OccupancyGrid, OccupancyParams, mapped_plan
 from sim.perception.laser import LaserParams, grid_caster, laser_angles, scan
 
 SMALL = OccupancyParams(resolution_m=0.1, bounds=(-2.0, 6.0, -3.0, 3.0))
@@ -136,3 +136,15 @@ def test_occupied_cells_reads_the_mask_at_cells_and_off_the_grid_says_no() -> No
     np.testing.assert_array_equal(grid.occupied_cells(rc), [True, False, False, False])
     every = np.argwhere(np.ones(grid.shape, dtype=bool))
     np.testing.assert_array_equal(grid.occupied_cells(every).reshape(grid.shape), grid.occupied_mask())
+
+
+def test_a_plan_mapped_whole_maps_a_wall_thinner_than_a_cell_and_leaves_the_floor_free():
+    from sim.world.data import Floorplan
+
+    occupied = np.zeros((100, 100), dtype=bool)  # 2 m x 2 m at 2 cm a pixel
+    occupied[:, 50] = True  # one pixel thick, at x = 1.00 .. 1.02 m
+    grid = mapped_plan(Floorplan(occupied, 0.02, (0.0, 0.0)), resolution_m=0.1)
+    assert grid.shape == (20, 20)
+    wall = grid.occupied_mask()
+    assert wall.sum() == 20 and wall[:, grid.world_to_cell(np.array([[1.01, 1.0]]))[0, 1]].all()
+    assert grid.free_mask().sum() == 20 * 19

@@ -7,9 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
+from sim.mapping.occupancy import OccupancyGrid, OccupancyParams, mapped_plan
 from sim.navigation.fingerposts import PostParams, PostTest, runs_into_wall
-from tests.mapped_grid import mapped
 
 
 def wall_at_south() -> OccupancyGrid:
@@ -71,7 +70,7 @@ def test_guided_reads_a_wayfinding_building_as_one_and_the_same_building_with_fi
         for tag in world.tags.values():
             if tag.kind == "sign":
                 policy.nav.model.observe_tag(tag.id, tag.text, (tag.x, tag.y, tag.theta), kind="sign")
-        policy.posts.judge(mapped(world), policy._signs_read())
+        policy.posts.judge(mapped_plan(world.floorplan), policy._signs_read())
         assert len(policy.posts.judged) == sum(t.kind == "sign" and "$" in t.text for t in world.tags.values())
         chances[arrows] = policy.bearing_share()
         prior = policy.goal_prior()

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from sim.mapping.occupancy import OccupancyGrid, OccupancyParams
+from sim.mapping.occupancy import OccupancyGrid, OccupancyParams, mapped_plan
 from sim.navigation.routes import (
     Arrow,
     PathSearches,
@@ -18,7 +18,6 @@ from sim.navigation.routes import (
     route_likelihood,
     walls_take_front,
 )
-from tests.mapped_grid import mapped
 
 
 def grid_of(walls: list[tuple[float, float, float, float]], size: tuple[float, float] = (20.0, 12.0)
@@ -134,7 +133,7 @@ def test_on_a_mapped_building_every_true_arrow_favours_the_place_it_names(style)
     from sim.world.generator import generate
 
     world = generate(0, style=style).world
-    grid = mapped(world)
+    grid = mapped_plan(world.floorplan)
     checked = 0
     for tag in world.tags.values():
         for line in tag.text.split("\n") if tag.kind == "sign" else ():
