@@ -19,6 +19,8 @@ from __future__ import annotations
 import math
 from collections import Counter
 
+from tqdm import tqdm
+
 from abstract_map.clauses import Locational
 from sim.experiments.survey import on_world, survey_parser
 from sim.mapping.occupancy import mapped_plan
@@ -60,13 +62,15 @@ def main(argv: list[str] | None = None) -> int:
     first, last = args.seeds if args.seeds else args.default_seeds
     totals: dict[str, Counter[bool]] = {reading: Counter() for reading in ARROW_READINGS}
     lines = []
-    for reading in ARROW_READINGS:
-        for style in STYLES:
-            counts: Counter[bool] = Counter()
-            for seed in range(first, last + 1):
-                counts += marks(generate(seed, style=style, signage="complete", arrows=reading).world)
-            totals[reading] += counts
-            lines.append(line(f"{style}, {reading}", counts))
+    with tqdm(total=len(ARROW_READINGS) * len(STYLES) * (last - first + 1), desc="buildings") as bar:
+        for reading in ARROW_READINGS:
+            for style in STYLES:
+                counts: Counter[bool] = Counter()
+                for seed in range(first, last + 1):
+                    counts += marks(generate(seed, style=style, signage="complete", arrows=reading).world)
+                    bar.update()
+                totals[reading] += counts
+                lines.append(line(f"{style}, {reading}", counts))
     lines += [line(f"all, {reading}", counts) for reading, counts in totals.items()]
     post, way = (totals[r][True] / max(1, totals[r][True] + totals[r][False]) for r in ("bearing", "way"))
     if 0 < way and post < 1:

@@ -29,3 +29,12 @@ def test_the_command_line_prints_one_line_for_a_world_and_refuses_an_unknown_one
     assert re.fullmatch(r"zoo +signs +6 +with the mark +6 +share 1\.000\n", capsys.readouterr().out)
     err = refused_in_one_line(script.main, ["--world", "no-such-world"], capsys, "fingerpost_marks")
     assert "no-such-world" in err
+
+
+def test_the_development_buildings_are_counted_by_style_and_reading_with_the_likelihood_ratios(capsys):
+    script = load()
+    assert script.main(["0", "0"]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"^office, way +signs +\d+", out, re.MULTILINE)
+    assert re.search(r"^all, bearing +signs +\d+ +with the mark +\d+ +share 0\.\d+$", out, re.MULTILINE)
+    assert re.search(r"^likelihood ratio: a sign with the mark \d+\.\d, without 0\.\d+$", out, re.MULTILINE)
