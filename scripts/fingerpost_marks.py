@@ -22,7 +22,7 @@ from collections import Counter
 from tqdm import tqdm
 
 from abstract_map.clauses import Locational
-from sim.experiments.survey import on_world, survey_parser
+from sim.experiments.survey import on_world, seed_range, survey_parser
 from sim.mapping.occupancy import mapped_plan
 from sim.navigation.fingerposts import PostParams, runs_into_wall
 from sim.world.data import World
@@ -57,9 +57,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.world:
         print(line(args.world, on_world(parser, args, "fingerpost_marks", marks)))
         return 0
-    if len(args.seeds) not in (0, 2):
-        parser.error("give FIRST LAST, or no seeds")
-    first, last = args.seeds if args.seeds else args.default_seeds
+    first, last = seed_range(parser, args)
     totals: dict[str, Counter[bool]] = {reading: Counter() for reading in ARROW_READINGS}
     lines = []
     with tqdm(total=len(ARROW_READINGS) * len(STYLES) * (last - first + 1), desc="buildings") as bar:

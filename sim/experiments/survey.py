@@ -38,11 +38,18 @@ def on_world(parser: argparse.ArgumentParser, args: argparse.Namespace, name: st
         parser.exit(2, f"{name}: {error}\n")
 
 
+def seed_range(parser: argparse.ArgumentParser, args: argparse.Namespace) -> tuple[int, int]:
+    """The first and last development seed asked for (the parser's default without any); two seeds or none,
+    else a usage error."""
+    if len(args.seeds) not in (0, 2):
+        parser.error("give FIRST LAST, or no seeds")
+    first, last = args.seeds if args.seeds else args.default_seeds
+    return first, last
+
+
 def buildings(parser: argparse.ArgumentParser, args: argparse.Namespace,
               spec_tail: str = "") -> Sequence[GeneratedSpec]:
     """The development buildings ``generated:FIRST-LAST`` (``spec_tail``, e.g. ``":signage=complete"``, added),
     with a progress bar; two seeds or none, else a usage error."""
-    if len(args.seeds) not in (0, 2):
-        parser.error("give FIRST LAST, or no seeds")
-    first, last = args.seeds if args.seeds else args.default_seeds
+    first, last = seed_range(parser, args)
     return tqdm(parse_world_spec(f"generated:{first}-{last}{spec_tail}").generated(), desc="buildings")

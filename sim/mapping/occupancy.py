@@ -240,10 +240,7 @@ def mapped_plan(plan: Floorplan, resolution_m: float = 0.1) -> OccupancyGrid:
     map had it seen the whole building, for measuring on true plans what the navigator reads off its own."""
     grid = OccupancyGrid(OccupancyParams(resolution_m=resolution_m, bounds=plan.extent))
     grid.log_odds[:] = -2.0
-    rows, cols = np.nonzero(plan.occupied)
-    x = plan.origin[0] + (cols + 0.5) * plan.resolution
-    y = plan.origin[1] + (plan.shape[0] - rows - 0.5) * plan.resolution
-    cells = grid.world_to_cell(np.stack([x, y], axis=1))
+    cells = grid.world_to_cell(plan.pixel_to_world(np.argwhere(plan.occupied)))
     inside = grid.in_bounds(cells)
     grid.log_odds[cells[inside, 0], cells[inside, 1]] = 3.0
     return grid

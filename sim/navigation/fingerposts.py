@@ -20,10 +20,10 @@ Measured on the generator's buildings (``python scripts/fingerpost_marks.py``:
 development seeds 0-11, every style, complete signage, the true plans;
 ``arrows=way`` and ``arrows=bearing`` of the same buildings; the reader 1 m in
 front of the sign, a wall within 1.5 m along the arrow): 80 % of fingerpost
-signs have such an arrow (72-88 % by style), 7.7 % of wayfinding signs (3-15 %; a first leg setting off back along the
-wall can round to DOWN). Counting any arrow that meets a wall, ahead too,
-gave 84 % against 13 %: a likelihood ratio of 6.5 where this one gives 10.4.
-Each sign read is one observation, weighed
+signs have such an arrow (72-88 % by style), 7.7 % of wayfinding signs (3-15 %;
+a first leg setting off back along the wall can round to DOWN). Counting any
+arrow that meets a wall, ahead too, gave 84 % against 13 %: a likelihood ratio
+of 6.5 where this one gives 10.4. Each sign read is one observation, weighed
 by Bayes' rule on the odds that the building's arrows are fingerposts
 (:class:`PostTest`); a sign is judged once, on the robot's map when it is
 first counted (unseen cells count as clear). The guided search gives that
