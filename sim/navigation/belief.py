@@ -69,6 +69,16 @@ class BeliefParams:
     family_sigma_m: float = 6.5  # m, spread of a place's label about a sibling's (same parent area) label: the
     # per-axis rms of sibling label distances on development buildings 0-99 is 6.6-6.8 m
     # (scripts/sibling_spread.py)
+    family_front_m: float = 0.5  # m in front of a label (along its facing) where the way it faces begins: the wall
+    # line's half width in "Labels of other areas" (docs/method-notes.md)
+    family_across_m: float = 4.0  # m in front of a label where the way it faces ends: past the widest corridor (3 m)
+    # and a label on its far wall; beyond lie halls and the next block, which this leaves alone
+    family_behind_m: float = 6.0  # m behind a label (into its own block) counted as its side when the building's
+    # pairs are counted (:func:`across_ratio`): the measurement's nearer bin behind, a room's depth
+    family_along_m: float = 10.0  # m along a label's wall within which a pair of labels read is counted at all:
+    # where one area's share of the labels on a wall line falls to about a half (same measurement)
+    family_pairs: float = 4.0  # pseudo-pairs on each side (half of them of one area) before the building's own
+    # pairs: a few pairs of labels read decide how a building's areas lie (as ``prior_misses`` for the model)
 
     def floor_m(self, placed_by: str) -> float:
         """The least spread (m) of the prior of a goal the cues read name ``placed_by`` (one of
@@ -224,6 +234,10 @@ class GoalPrior:
     sigma_m: float  # m, spread about it (:func:`goal_sigma`)
     family_xy: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (K, 2) m, labels read of places
     # sharing the goal's parent area (none when that parent is the hierarchy's root)
+    family_facing: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (K,) rad, the way each of those labels
+    # faces (is read from); empty: not known, each sibling's component even all round
+    family_across: float = 1.0  # density of a sibling's component across the way its label faces against beside
+    # and behind it (:func:`across_ratio`, learned from the labels read in this building); 1: even all round
 
 
 @dataclass(frozen=True)
@@ -330,12 +344,53 @@ def place_density(grid: OccupancyGrid, prior: GoalPrior, params: BeliefParams) -
     xy_col, xy_row = grid.cell_axes()
     components = [((1.0 - params.tail_weight) * w, c, s) for w, c, s in prior_components(prior, params)]
     components.append((params.tail_weight, centre, params.tail_scale * prior.sigma_m))
+    facing = np.asarray(prior.family_facing, dtype=float).ravel()
+    if len(facing) != len(np.asarray(prior.family_xy).reshape(-1, 2)):
+        facing = np.zeros(0)
     density = np.zeros(grid.shape)
-    for weight, mean, spread in components:
+    for k, (weight, mean, spread) in enumerate(components):
         gx = np.exp(-0.5 * ((xy_col - mean[0]) / spread) ** 2)
         gy = np.exp(-0.5 * ((xy_row - mean[1]) / spread) ** 2)
-        density += weight / spread ** 2 * np.outer(gy, gx)
+        part = weight / spread ** 2 * np.outer(gy, gx)
+        if 1 <= k <= len(facing) and prior.family_across < 1.0:  # a sibling's component (after the goal's)
+            part = sided(part, xy_col - mean[0], xy_row - mean[1], facing[k - 1], prior.family_across, params)
+        density += part
     return density
+
+
+def sided(part: np.ndarray, dx: np.ndarray, dy: np.ndarray, facing: float, across: float,
+          params: BeliefParams) -> np.ndarray:
+    """``part`` (rows, cols) with the cells across the way a label facing ``facing`` (rad) looks onto (from
+    ``family_front_m`` to ``family_across_m`` in front of it) scaled by ``across``, then scaled back to ``part``'s
+    sum. ``dx`` (cols,) and ``dy`` (rows,) are the cells' offsets (m) from the label."""
+    ahead = dx[None, :] * math.cos(facing) + dy[:, None] * math.sin(facing)
+    shaped = np.where((ahead > params.family_front_m) & (ahead <= params.family_across_m), across * part, part)
+    total = float(shaped.sum())
+    return shaped * (float(part.sum()) / total) if total > 0 else part
+
+
+def across_ratio(xy: np.ndarray, facing: np.ndarray, area: Sequence[str], params: BeliefParams) -> float:
+    """How likely a label across the way another faces is of the same area, against one beside or behind it,
+    from the ``K`` labels read so far in this building (``xy`` (K, 2) m, ``facing`` (K,) rad, ``area``: each
+    one's parent area). Over ordered pairs within ``family_along_m`` along the first's wall: the share of one
+    area across (``family_front_m`` to ``family_across_m`` in front) over the share beside or behind (to
+    ``family_behind_m`` behind), each share with ``family_pairs`` pseudo-pairs half of one area, at most 1.
+    Where areas are blocks between corridors (the generator's), the way a label faces holds other areas'
+    labels and the ratio falls to about a tenth; where an area lines both sides of a path (the zoo's), it
+    stays 1."""
+    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+    d = xy[None, :, :] - xy[:, None, :]  # [i, j]: from label i to label j
+    c, s = np.cos(facing)[:, None], np.sin(facing)[:, None]
+    ahead, along = d[..., 0] * c + d[..., 1] * s, np.abs(-d[..., 0] * s + d[..., 1] * c)
+    names = np.asarray(area, dtype=object)
+    same = names[:, None] == names[None, :]
+    counted = (along <= params.family_along_m) & ~np.eye(len(xy), dtype=bool)
+    side = counted & (ahead >= -params.family_behind_m) & (ahead <= params.family_front_m)
+    across = counted & (ahead > params.family_front_m) & (ahead <= params.family_across_m)
+    n0 = params.family_pairs
+    share_side = (float((same & side).sum()) + n0 / 2) / (float(side.sum()) + n0)
+    share_across = (float((same & across).sum()) + n0 / 2) / (float(across.sum()) + n0)
+    return min(1.0, share_across / share_side)
 
 
 def goal_belief(grid: OccupancyGrid, swept: np.ndarray, prior: GoalPrior | MixedPrior, params: BeliefParams,

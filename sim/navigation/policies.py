@@ -53,6 +53,7 @@ from sim.navigation.belief import (
     GoalPrior,
     MixedPrior,
     SweptSpace,
+    across_ratio,
     cue_mass,
     goal_belief,
     goal_sigma,
@@ -258,11 +259,12 @@ class AbstractMapPolicy(Driven):
     def goal_prior(self, belief: BeliefParams | None = None) -> GoalPrior:
         """The goal's imagined position (m; off the map too: a prior's near edge then lies on it), the spread
         (m) the model earns there (:func:`sim.navigation.belief.goal_sigma`, with ``belief`` or the policy's own
-        parameters) and the labels read of its siblings (:meth:`family_labels`)."""
+        parameters) and the labels read of its siblings, with the way each faces and how much that counts in
+        this building (:meth:`family`)."""
         goal = self.nav.model.goal_estimate()
         anchors = np.array([f.xy for f in self.nav.model.fixed.values()])
         return GoalPrior(goal, goal_sigma(goal, anchors, belief or self.params.belief, self.nav.misses_m,
-                                          self.placed_by()), self.family_labels())
+                                          self.placed_by()), *self.family())
 
     def placed_by(self) -> str:
         """How the cues read so far name the goal, the surest way (:func:`abstract_map.clauses.named_by`)."""
@@ -274,10 +276,21 @@ class AbstractMapPolicy(Driven):
         """(K, 2) m: where the labels read of the goal's siblings hang (places with the goal's parent area,
         the goal excluded); none when the goal has no parent or its parent is the hierarchy's root (the
         whole building is no area)."""
-        model, siblings = self.nav.model, self._siblings()
-        out = [model.fixed[anchor].xy for anchor, clauses in model.cue_clauses.items() for c in clauses
-               if isinstance(c, Locational) and c.kind == "label" and model.canonical(c.toponym) in siblings]
-        return np.array(out, dtype=float).reshape(-1, 2)
+        return self.family()[0]
+
+    def family(self) -> tuple[np.ndarray, np.ndarray, float]:
+        """:meth:`family_labels`, the way each of those labels faces ((K,) rad) and how much the way they face
+        counts (:func:`sim.navigation.belief.across_ratio` of every label read of a place in an area)."""
+        model, siblings, parents = self.nav.model, self._siblings(), self.nav.model.hierarchy.parent
+        read = [(model.fixed[anchor], model.canonical(c.toponym)) for anchor, clauses in model.cue_clauses.items()
+                for c in clauses if isinstance(c, Locational) and c.kind == "label"]
+        found = [point for point, name in read if name in siblings]
+        in_areas = [(point, parents[name]) for point, name in read if parents.get(name) in parents]
+        across = across_ratio(np.array([p.xy for p, _ in in_areas], dtype=float),
+                              np.array([p.theta for p, _ in in_areas], dtype=float),
+                              [a for _, a in in_areas], self.params.belief) if found else 1.0
+        return (np.array([f.xy for f in found], dtype=float).reshape(-1, 2),
+                np.array([f.theta for f in found], dtype=float), across)
 
     def _siblings(self) -> set[str]:
         """The places sharing the goal's parent area, the goal excluded; none when the goal has no parent or its
@@ -584,9 +597,11 @@ class GuidedPolicy(AbstractMapPolicy):
     The belief over where the goal's label hangs is the viewpoint policy's
     (:func:`sim.navigation.belief.goal_belief`): the abstract map's imagined goal
     as a prior, as wide as the model's own misses in this building, mixed with
-    the labels read of the goal's siblings (:meth:`family_labels`) as the model
-    is trusted less, times every arrow read that names the goal or an area holding it
-    and the doorways between the start and each place
+    the labels read of the goal's siblings (:meth:`family`) as the model
+    is trusted less (each on its own side of the way its label faces, as far as
+    the labels read in this building say that an area keeps to one side of a
+    corridor: :func:`sim.navigation.belief.across_ratio`), times every arrow
+    read that names the goal or an area holding it and the doorways between the start and each place
     (:mod:`sim.navigation.routes`), on mapped walls more than in unseen space,
     and little where the robot has already looked. Each frontier is worth the
     belief whose route from the robot enters unlooked space through it, as far
@@ -798,7 +813,7 @@ class KnownGoalPolicy(GuidedPolicy):
         self.label_xy = np.array([tag.x, tag.y], dtype=float)
 
     def goal_prior(self) -> GoalPrior:
-        return GoalPrior(self.label_xy, self.params.guide.known_spread_m, self.family_labels())
+        return GoalPrior(self.label_xy, self.params.guide.known_spread_m, *self.family())
 
 
 class KnownPosePolicy(SignBlind):

@@ -11,10 +11,12 @@ from sim.navigation.belief import (
     GoalPrior,
     MixedPrior,
     SweptSpace,
+    across_ratio,
     cue_mass,
     goal_belief,
     goal_sigma,
     labels_near_places,
+    place_density,
     prior_components,
     sight_clear,
 )
@@ -150,6 +152,42 @@ def test_belief_moves_to_where_siblings_were_read():
     bottom = wall_cells_at(grid, 1.0)
     assert family.mass[top].sum() > alone.mass[top].sum()
     assert family.mass[bottom].sum() < alone.mass[bottom].sum()
+
+
+def corridor_labels(areas: list[str]) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Three labels on a corridor's north wall (y = 2.4 m, facing south) and three on its south wall (y = 0,
+    facing north), 5 m apart, of ``areas`` in that order."""
+    xy = np.array([(0.0, 2.4), (5.0, 2.4), (10.0, 2.4), (1.0, 0.0), (6.0, 0.0), (11.0, 0.0)])
+    facing = np.array([-np.pi / 2] * 3 + [np.pi / 2] * 3)
+    return xy, facing, areas
+
+
+def test_the_way_labels_face_is_learned_from_the_labels_read():
+    """Areas as blocks (one area each side of the corridor): a sibling says little of the far wall. One area on
+    both sides (a zoo's path): the far wall counts as the near one. Nothing read: even all round."""
+    params = BeliefParams()
+    blocks = across_ratio(*corridor_labels(["A"] * 3 + ["B"] * 3), params)
+    assert 0.05 < blocks < 0.2
+    assert across_ratio(*corridor_labels(["A"] * 6), params) == 1.0
+    assert across_ratio(np.zeros((0, 2)), np.zeros(0), [], params) == 1.0
+    few = across_ratio(corridor_labels(["A", "B"])[0][[0, 3]], np.array([-np.pi / 2, np.pi / 2]), ["A", "B"], params)
+    assert blocks < few < 1.0  # one pair moves the pseudo-pairs' even start a little
+
+
+def test_a_siblings_share_across_the_way_its_label_faces_moves_to_its_own_wall():
+    """A sibling's label on the mapped wall's west face (x = 6 m, facing west), the model trusted little (30 m):
+    with ``family_across`` a tenth, the space 0.5-4 m west of it (across the corridor) loses density to the
+    wall's side and the far side of the wall, and the density keeps its sum."""
+    grid, params = corridor(), BeliefParams()
+    label = np.array([[WALL_X, 4.0]])
+    even = GoalPrior(np.array([2.0, 4.0]), 30.0, label, np.array([np.pi]), 1.0)
+    sided = GoalPrior(np.array([2.0, 4.0]), 30.0, label, np.array([np.pi]), 0.1)
+    a, b = place_density(grid, even, params), place_density(grid, sided, params)
+    assert b.sum() == pytest.approx(a.sum(), rel=1e-6)
+    across = grid.world_to_cell(np.array([[WALL_X - 2.0, 4.0]]))[0]
+    behind = grid.world_to_cell(np.array([[WALL_X + 1.0, 4.0]]))[0]
+    assert b[tuple(across)] < 0.5 * a[tuple(across)]
+    assert b[tuple(behind)] > a[tuple(behind)]
 
 
 def test_a_mixed_prior_weighs_each_part_as_a_whole_over_the_grid():
