@@ -18,7 +18,7 @@ from tqdm import tqdm
 
 from abstract_map.hierarchy import Hierarchy
 from sim.experiments.world_spec import parse_world_spec
-from sim.navigation.belief import BeliefParams, across_ratio
+from sim.navigation.belief import BeliefParams, across_ratio, label_offsets
 from sim.world.data import Tag, load_world
 from sim.world.generator import generate
 
@@ -31,21 +31,17 @@ def area_labels(tags: Iterable[Tag], parent: dict[str, str]) -> list[tuple[Tag, 
 
 
 def band_counts(labels: list[tuple[Tag, str]], along_m: float) -> tuple[np.ndarray, np.ndarray]:
-    """Per band of :data:`BANDS_M`: pairs of one area, and all pairs."""
-    same, every = np.zeros(len(BANDS_M) - 1), np.zeros(len(BANDS_M) - 1)
-    for a, area_a in labels:
-        for b, area_b in labels:
-            if a is b or a.text == b.text:
-                continue
-            dx, dy = b.x - a.x, b.y - a.y
-            ahead = dx * np.cos(a.theta) + dy * np.sin(a.theta)
-            if abs(-dx * np.sin(a.theta) + dy * np.cos(a.theta)) > along_m:
-                continue
-            k = int(np.searchsorted(BANDS_M, ahead, side="right")) - 1
-            if 0 <= k < len(same):
-                every[k] += 1
-                same[k] += area_a == area_b
-    return same, every
+    """Per band of :data:`BANDS_M`: pairs of one area, and all pairs (two labels of one place not a pair)."""
+    ahead, along = label_offsets(np.array([(t.x, t.y) for t, _ in labels]), np.array([t.theta for t, _ in labels]))
+    texts = np.array([t.text for t, _ in labels], dtype=object)
+    areas = np.array([a for _, a in labels], dtype=object)
+    counted = (along <= along_m) & (texts[:, None] != texts[None, :])
+    band = np.searchsorted(BANDS_M, ahead, side="right") - 1
+    counted &= (band >= 0) & (band < len(BANDS_M) - 1)
+    same = areas[:, None] == areas[None, :]
+    bins = len(BANDS_M) - 1
+    return (np.bincount(band[counted & same], minlength=bins).astype(float),
+            np.bincount(band[counted], minlength=bins).astype(float))
 
 
 def ratio(labels: list[tuple[Tag, str]], params: BeliefParams) -> float:

@@ -345,8 +345,10 @@ def place_density(grid: OccupancyGrid, prior: GoalPrior, params: BeliefParams) -
     components = [((1.0 - params.tail_weight) * w, c, s) for w, c, s in prior_components(prior, params)]
     components.append((params.tail_weight, centre, params.tail_scale * prior.sigma_m))
     facing = np.asarray(prior.family_facing, dtype=float).ravel()
-    if len(facing) != len(np.asarray(prior.family_xy).reshape(-1, 2)):
-        facing = np.zeros(0)
+    siblings = len(np.asarray(prior.family_xy).reshape(-1, 2))
+    if len(facing) not in (0, siblings):
+        raise ValueError(f"family_facing must give one facing per sibling label ({siblings}) or none, "
+                         f"got {len(facing)}")
     density = np.zeros(grid.shape)
     for k, (weight, mean, spread) in enumerate(components):
         gx = np.exp(-0.5 * ((xy_col - mean[0]) / spread) ** 2)
@@ -369,6 +371,16 @@ def sided(part: np.ndarray, dx: np.ndarray, dy: np.ndarray, facing: float, acros
     return shaped * (float(part.sum()) / total) if total > 0 else part
 
 
+def label_offsets(xy: np.ndarray, facing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For labels at ``xy`` ((K, 2) m) facing ``facing`` ((K,) rad), per ordered pair ``[i, j]``: how far label
+    ``j`` lies in front of label ``i`` (m, along ``i``'s facing; negative: behind) and how far along ``i``'s
+    wall (m, unsigned)."""
+    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+    d = xy[None, :, :] - xy[:, None, :]  # [i, j]: from label i to label j
+    c, s = np.cos(facing)[:, None], np.sin(facing)[:, None]
+    return d[..., 0] * c + d[..., 1] * s, np.abs(-d[..., 0] * s + d[..., 1] * c)
+
+
 def across_ratio(xy: np.ndarray, facing: np.ndarray, area: Sequence[str], params: BeliefParams) -> float:
     """How likely a label across the way another faces is of the same area, against one beside or behind it,
     from the ``K`` labels read so far in this building (``xy`` (K, 2) m, ``facing`` (K,) rad, ``area``: each
@@ -379,9 +391,7 @@ def across_ratio(xy: np.ndarray, facing: np.ndarray, area: Sequence[str], params
     labels and the ratio falls to about a tenth; where an area lines both sides of a path (the zoo's), it
     stays 1."""
     xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-    d = xy[None, :, :] - xy[:, None, :]  # [i, j]: from label i to label j
-    c, s = np.cos(facing)[:, None], np.sin(facing)[:, None]
-    ahead, along = d[..., 0] * c + d[..., 1] * s, np.abs(-d[..., 0] * s + d[..., 1] * c)
+    ahead, along = label_offsets(xy, facing)
     names = np.asarray(area, dtype=object)
     same = names[:, None] == names[None, :]
     counted = (along <= params.family_along_m) & ~np.eye(len(xy), dtype=bool)

@@ -190,6 +190,13 @@ def test_a_siblings_share_across_the_way_its_label_faces_moves_to_its_own_wall()
     assert b[tuple(behind)] > a[tuple(behind)]
 
 
+def test_facings_that_do_not_match_the_siblings_are_refused():
+    grid = corridor()
+    prior = GoalPrior(np.array([2.0, 4.0]), 3.0, np.array([[WALL_X, 4.0], [WALL_X, 6.0]]), np.array([np.pi]), 0.1)
+    with pytest.raises(ValueError, match="one facing per sibling label"):
+        place_density(grid, prior, BeliefParams())
+
+
 def test_a_mixed_prior_weighs_each_part_as_a_whole_over_the_grid():
     """A part of weight 1 is the plain prior; a narrow prior at the wall's south end mixed half and half with
     one a kilometre wide puts on the north half of the wall the mean of what each alone puts there, although
