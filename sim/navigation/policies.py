@@ -74,6 +74,7 @@ from sim.navigation.gateways import GuideParams, frontier_values
 from sim.navigation.navigator import CueEvent, Navigator, NavigatorParams
 from sim.navigation.planner import Plan, PlannerParams
 from sim.navigation.replanner import Replanner, ReplanParams
+from sim.navigation.rooms import RoomParams, other_rooms_likelihood
 from sim.navigation.routes import (
     Arrow,
     PathSearches,
@@ -91,8 +92,8 @@ from sim.world.data import Tag, World
 
 Pose = tuple[float, float, float]
 
-EVIDENCE_FACTORS = ("doors", "arrows", "unnamed signs")  # the goal evidence's factors, in the order they
-# multiply (AbstractMapPolicy.evidence_factors)
+EVIDENCE_FACTORS = ("doors", "arrows", "unnamed signs", "other rooms")  # the goal evidence's factors, in the
+# order they multiply (AbstractMapPolicy.evidence_factors)
 
 
 @dataclass(frozen=True)
@@ -111,6 +112,7 @@ class PolicyParams:
     guide: GuideParams = field(default_factory=GuideParams)
     spotted: SpottedParams = field(default_factory=SpottedParams)
     footprint: FootprintParams = field(default_factory=FootprintParams)
+    rooms: RoomParams = field(default_factory=RoomParams)
 
 
 class Policy(Protocol):
@@ -350,15 +352,34 @@ class AbstractMapPolicy(Driven):
                 out.append((sign.x + stand * math.cos(sign.theta), sign.y + stand * math.sin(sign.theta)))
         return out
 
+    def other_doors(self) -> list[tuple[tuple[float, float], float]]:
+        """Each label read (position m, facing rad) of a place whose parent is an area that neither is nor holds
+        the goal's: the room behind its door is another area's (:mod:`sim.navigation.rooms`)."""
+        model, parents = self.nav.model, self.nav.model.hierarchy.parent
+        own = self._areas()
+        out = []
+        for anchor, clauses in model.cue_clauses.items():
+            tag = model.fixed.get(anchor)
+            for c in clauses:
+                if tag is None or not isinstance(c, Locational) or c.kind != "label":
+                    continue
+                name = model.canonical(c.toponym)
+                area = parents.get(name)
+                if name != self.nav.goal and area in parents and area not in own:
+                    out.append(((tag.x, tag.y), tag.theta))
+        return out
+
     def evidence_factors(self, grid: OccupancyGrid, routes: RouteParams, searches: PathSearches,
                          names: Iterable[str] = EVIDENCE_FACTORS) -> dict[str, np.ndarray]:
         """The evidence's factors ``names`` (of :data:`EVIDENCE_FACTORS`, in that order), per grid cell, worked out
-        with the route parameters ``routes``: door depth from the start, the likelihood of the arrows read and that
-        of the signs read that name neither the goal nor an area holding it. A factor with nothing to say (no
-        such arrow or sign read) is left out; door depth is always there."""
+        with the route parameters ``routes``: door depth from the start, the likelihood of the arrows read, that
+        of the signs read that name neither the goal nor an area holding it, and that of the rooms behind doors
+        whose labels name another area's place (:mod:`sim.navigation.rooms`). A factor with nothing to say (no
+        such arrow, sign or door read) is left out; door depth is always there."""
         makers = {"doors": lambda: door_depth_weight(grid, self.start[:2], routes, searches),
                   "arrows": lambda: route_likelihood(grid, self.arrows(), routes, searches, self.bearing_share()),
-                  "unnamed signs": lambda: passed_likelihood(grid, self.unnamed(), self.start[:2], routes, searches)}
+                  "unnamed signs": lambda: passed_likelihood(grid, self.unnamed(), self.start[:2], routes, searches),
+                  "other rooms": lambda: other_rooms_likelihood(grid, self.other_doors(), self.params.rooms)}
         found = {name: makers[name]() for name in names}
         return {name: factor for name, factor in found.items() if factor is not None}
 
@@ -373,11 +394,11 @@ class AbstractMapPolicy(Driven):
         return self.factors.get("doors", np.ones(1))
 
     def _evidence(self, grid: OccupancyGrid) -> np.ndarray:
-        """Door depth x route likelihood of the arrows read x that of the signs not naming the goal, per grid
-        cell; refreshed when a new sign is read or every ``evidence_every_s`` (walls and doors are mapped
-        slowly)."""
+        """Door depth x route likelihood of the arrows read x that of the signs not naming the goal x that of the
+        rooms behind doors labelled with another area's place, per grid cell; refreshed when a new sign or such a
+        label is read or every ``evidence_every_s`` (walls and doors are mapped slowly)."""
         arrows, unnamed = self.arrows(), self.unnamed()
-        key = (*arrows, *unnamed, self.bearing_share())
+        key = (*arrows, *unnamed, len(self.other_doors()), self.bearing_share())
         if self.evidence is None or key != self.evidence_key or self.now - self.evidence_at >= \
                 self.params.routes.evidence_every_s:
             self.factors = self.evidence_factors(grid, self.params.routes, self.searches)
@@ -602,7 +623,8 @@ class GuidedPolicy(AbstractMapPolicy):
     the labels read in this building say that an area keeps to one side of a
     corridor: :func:`sim.navigation.belief.across_ratio`), times every arrow
     read that names the goal or an area holding it and the doorways between the start and each place
-    (:mod:`sim.navigation.routes`), on mapped walls more than in unseen space,
+    (:mod:`sim.navigation.routes`), little in the rooms behind doors whose labels name another area's place
+    (:mod:`sim.navigation.rooms`), on mapped walls more than in unseen space,
     and little where the robot has already looked. Each frontier is worth the
     belief whose route from the robot enters unlooked space through it, as far
     as a walk on past it gives the best rate of belief per metre

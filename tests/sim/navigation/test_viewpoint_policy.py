@@ -333,3 +333,28 @@ def test_even_prior_is_guided_with_the_abstract_maps_point_dropped(tiny_world):
         return float(mass.max() / mass[mass > 0].mean())
 
     assert peak(even.belief.mass) < 1.5 < peak(guided.belief.mass)  # what is left of even's is the evidence's
+
+
+def test_labels_of_other_areas_rooms_are_the_doors_whose_rooms_are_ruled_out(tmp_path):
+    """A label read of a place in an area that neither is nor holds the goal's gives its room to the "other
+    rooms" evidence; a sibling's label, the goal's own and an area's do not."""
+    from abstract_map.hierarchy import Hierarchy
+    from sim.experiments.trial import TrialParams, policy_params
+    from sim.navigation.policies import GuidedPolicy
+    from sim.world.data import load_world
+    from sim.world.generator import generated_world
+
+    world = load_world(generated_world(0, style="office", size="medium", signage="complete", root=tmp_path))
+    parent = Hierarchy.from_xml(world.hierarchy_path).parent
+    goal = sorted(world.goals)[0]
+    area = parent[goal]
+    labels = {t.text: t for t in world.tags.values() if t.kind == "label"}
+    sibling = sorted(p for p in labels if parent.get(p) == area and p != goal)[0]
+    stranger = sorted(p for p in labels if parent.get(p) in parent and parent[p] != area and p != goal)[0]
+    policy = GuidedPolicy(world, goal, world.start, policy_params(TrialParams()))
+    assert policy.other_doors() == []
+    for name in (sibling, stranger, goal):
+        tag = labels[name]
+        policy.nav.model.observe_tag(tag.id, tag.text, (tag.x, tag.y, tag.theta))
+    tag = labels[stranger]
+    assert policy.other_doors() == [((tag.x, tag.y), tag.theta)]
