@@ -54,6 +54,9 @@ def main(argv: list[str]) -> int:
     walked: Counter[tuple[str, str]] = Counter()
     trials = 0
     for study in map(Path, argv):
+        if not (study / "trials.csv").is_file():
+            print(f"room_walks: {study} is not a study folder (no trials.csv)")
+            return 2
         rows = list(csv.DictReader((study / "trials.csv").open()))
         seeds = sorted({int(r["world"].rsplit("-", 1)[1]) for r in rows})
         plans = {b.seed: generate(b.seed, style=b.style, signage=b.signage).layout

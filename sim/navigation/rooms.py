@@ -9,15 +9,16 @@ room reached through it, holds no label of the goal's, unless the building
 mixes areas within a suite (``RoomParams.other_suite_prob``).
 
 The room is found on the robot's own map (world frame, metres): the doorway is
-a passage narrower than a door (``door_width_m``) at the label's wall within
+a gap in the label's wall, ``door_min_m`` to ``door_width_m`` wide, within
 ``door_near_m`` of the label; the room is the open space behind the label's
 wall, joined to a point just behind it without passing through anything as
-narrow as that doorway, within ``reach_m`` of the label. Unseen space counts as
-open, so before the room is mapped its region is the unseen space behind the
-wall out to ``reach_m``: on the generator's buildings a block of rooms between
-corridors is one area, so that is still the label's area. A label with no
-doorway beside it (an enclosure's plate in a zoo, a sign on open ground) says
-nothing here.
+narrow as that doorway, within ``reach_m`` of the label. So a mapped room's
+region is the room itself (the rooms reached through it lie behind doorways
+of their own). Unseen space counts as open, so before the room is mapped its
+region is the unseen space behind the wall out to ``reach_m``: on the
+generator's buildings a block of rooms between corridors is one area, so that
+is still the label's area. A label with no doorway beside it (an enclosure's
+plate in a zoo, a sign on open ground) says nothing here.
 """
 
 from __future__ import annotations
