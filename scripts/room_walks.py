@@ -12,17 +12,16 @@ Prints metres per trial (all trials of all folders) walked inside the free part 
 
 from __future__ import annotations
 
-import csv
-import json
 import sys
 from collections import Counter
+from functools import cache
 from pathlib import Path
 
 import numpy as np
 
-from sim.experiments.world_spec import parse_world_spec
+from sim.experiments.compare import CompareError, load_records
 from sim.world.generator import generate
-from sim.world.layout import Room
+from sim.world.layout import Layout, Room
 
 
 def inside(rect: tuple[float, float, float, float], xy: np.ndarray) -> np.ndarray:
@@ -42,9 +41,11 @@ def kind_of(room: Room, goal: Room, rooms: dict[str, Room]) -> str:
     return "the goal's area" if room.area == goal.area else "another area's"
 
 
-def trial_file(study: Path, row: dict[str, str]) -> Path:
-    name = f"{row['navigator']}-{row['goal'].replace(' ', '_')}-{row['seed']}-*.json"
-    return next((study / "trials" / row["world"]).glob(name))
+@cache
+def plan(world: str, style: str, signage: str) -> Layout:
+    """The generator's plan of the building ``world`` (``gen-STYLE-SIZE-SIGNAGE[-ARROWS]-SEED``)."""
+    parts = world.split("-")
+    return generate(int(parts[-1]), style=style, size=parts[2], signage=signage).layout
 
 
 def main(argv: list[str]) -> int:
@@ -54,20 +55,17 @@ def main(argv: list[str]) -> int:
     walked: Counter[tuple[str, str]] = Counter()
     trials = 0
     for study in map(Path, argv):
-        if not (study / "trials.csv").is_file():
-            print(f"room_walks: {study} is not a study folder (no trials.csv)")
+        try:
+            records = load_records(study)
+        except CompareError as exc:
+            print(f"room_walks: {exc}")
             return 2
-        rows = list(csv.DictReader((study / "trials.csv").open()))
-        seeds = sorted({int(r["world"].rsplit("-", 1)[1]) for r in rows})
-        plans = {b.seed: generate(b.seed, style=b.style, signage=b.signage).layout
-                 for b in parse_world_spec(f"generated:{seeds[0]}-{seeds[-1]}").generated() if b.seed in seeds}
-        for row in rows:
-            rooms = {r.name: r for r in plans[int(row["world"].rsplit("-", 1)[1])].rooms}
+        for result in records:
+            rooms = {r.name: r for r in plan(result["world"], result["style"], result["signage"]).rooms}
             trials += 1
-            goal = rooms.get(row["goal"])
+            goal = rooms.get(result["goal"])
             if goal is None:
                 continue
-            result = json.loads(trial_file(study, row).read_text())
             path = np.array(result["trajectory"])[:, 1:3]
             step = np.hypot(*np.diff(path, axis=0).T)
             at_m = np.concatenate([[0.0], np.cumsum(step)])

@@ -21,7 +21,7 @@ from scipy import ndimage
 from skimage.graph import MCP_Geometric
 
 from sim.mapping.occupancy import OccupancyGrid
-from sim.navigation.planner import distance_to_occupied
+from sim.navigation.planner import clearance_m
 from sim.navigation.targeting import filled_free, seen_passable
 
 _EIGHT = np.ones((3, 3), dtype=bool)
@@ -151,9 +151,7 @@ def _frontier_mask(grid: OccupancyGrid, robot_radius_m: float, params: FrontierP
                    covered: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
     """:func:`frontier_mask` over every cell of ``grid``."""
     filled = filled_free(grid, params.fill_holes_cells)
-    # Clearance (m) exact up to just past the robot's radius, inf beyond: all that passability asks of it.
-    cap = int(np.ceil(robot_radius_m / grid.resolution)) + 1
-    clearance = distance_to_occupied(grid.occupied_mask(), cap).astype(float) * grid.resolution
+    clearance = clearance_m(grid, robot_radius_m)  # all that passability asks of it
     passable = seen_passable(grid, clearance, robot_radius_m, params.fill_holes_cells, filled)
     occupied = grid.occupied_mask()
     unknown = ~(grid.free_mask() | filled) & ~occupied  # the closing fills; never erodes

@@ -97,6 +97,13 @@ def distance_to_occupied(occupied: np.ndarray, cap_cells: int) -> np.ndarray:
     return distance
 
 
+def clearance_m(grid: OccupancyGrid, up_to_m: float) -> np.ndarray:
+    """Per cell of ``grid``, the distance (m, centre to centre) to the nearest mapped wall: exact up to just past
+    ``up_to_m`` (all a caller asks of it), inf beyond (:func:`distance_to_occupied`)."""
+    cap = int(math.ceil(up_to_m / grid.resolution)) + 1
+    return distance_to_occupied(grid.occupied_mask(), cap).astype(float) * grid.resolution
+
+
 def cost_map(grid: OccupancyGrid, params: PlannerParams = PlannerParams()) -> CostMap:
     """Costs of every cell of ``grid`` under ``params`` (no start-escape zone)."""
     occupied = grid.occupied_mask()

@@ -45,7 +45,7 @@ from typing import Protocol
 import numpy as np
 
 from abstract_map.clauses import Clause, Locational, clause_names, is_anchor, named_by
-from abstract_map.model import SettleReport, imagined_positions
+from abstract_map.model import FixedPoint, SettleReport, imagined_positions
 from sim.mapping.occupancy import OccupancyGrid
 from sim.navigation.belief import (
     Belief,
@@ -280,12 +280,17 @@ class AbstractMapPolicy(Driven):
         whole building is no area)."""
         return self.family()[0]
 
+    def labels_read(self) -> list[tuple[FixedPoint, str]]:
+        """Each label read: where it hangs and which way it faces (its fixed point), and the place it names
+        (canonical spelling)."""
+        model = self.nav.model
+        return [(model.fixed[anchor], model.canonical(c.toponym)) for anchor, clauses in model.cue_clauses.items()
+                for c in clauses if isinstance(c, Locational) and c.kind == "label"]
+
     def family(self) -> tuple[np.ndarray, np.ndarray, float]:
         """:meth:`family_labels`, the way each of those labels faces ((K,) rad) and how much the way they face
         counts (:func:`sim.navigation.belief.across_ratio` of every label read of a place in an area)."""
-        model, siblings, parents = self.nav.model, self._siblings(), self.nav.model.hierarchy.parent
-        read = [(model.fixed[anchor], model.canonical(c.toponym)) for anchor, clauses in model.cue_clauses.items()
-                for c in clauses if isinstance(c, Locational) and c.kind == "label"]
+        siblings, parents, read = self._siblings(), self.nav.model.hierarchy.parent, self.labels_read()
         found = [point for point, name in read if name in siblings]
         in_areas = [(point, parents[name]) for point, name in read if parents.get(name) in parents]
         across = across_ratio(np.array([p.xy for p, _ in in_areas], dtype=float),
@@ -355,19 +360,9 @@ class AbstractMapPolicy(Driven):
     def other_doors(self) -> list[tuple[tuple[float, float], float]]:
         """Each label read (position m, facing rad) of a place whose parent is an area that neither is nor holds
         the goal's: the room behind its door is another area's (:mod:`sim.navigation.rooms`)."""
-        model, parents = self.nav.model, self.nav.model.hierarchy.parent
-        own = self._areas()
-        out = []
-        for anchor, clauses in model.cue_clauses.items():
-            tag = model.fixed.get(anchor)
-            for c in clauses:
-                if tag is None or not isinstance(c, Locational) or c.kind != "label":
-                    continue
-                name = model.canonical(c.toponym)
-                area = parents.get(name)
-                if name != self.nav.goal and area in parents and area not in own:
-                    out.append(((tag.x, tag.y), tag.theta))
-        return out
+        parents, own = self.nav.model.hierarchy.parent, self._areas()
+        return [((tag.x, tag.y), tag.theta) for tag, name in self.labels_read()
+                if name != self.nav.goal and parents.get(name) in parents and parents[name] not in own]
 
     def evidence_factors(self, grid: OccupancyGrid, routes: RouteParams, searches: PathSearches,
                          names: Iterable[str] = EVIDENCE_FACTORS) -> dict[str, np.ndarray]:

@@ -31,7 +31,7 @@ import numpy as np
 from scipy import ndimage
 
 from sim.mapping.occupancy import OccupancyGrid
-from sim.navigation.planner import distance_to_occupied
+from sim.navigation.planner import clearance_m
 
 
 @dataclass(frozen=True)
@@ -52,10 +52,12 @@ class RoomParams:
     # between corridors, two rooms deep) and little of the next block
 
 
-def doorway_beside(grid: OccupancyGrid, label_xy: np.ndarray, facing: float, params: RoomParams) -> bool:
+def doorway_beside(grid: OccupancyGrid, free: np.ndarray, label_xy: np.ndarray, facing: float,
+                   params: RoomParams) -> bool:
     """Whether the wall a label at ``label_xy`` (m) facing ``facing`` (rad) hangs on has a doorway beside it: a
-    run of mapped free cells along the wall's mid-line, ``wall_line_m`` behind the label, at least
-    ``door_min_m`` and at most ``door_width_m`` long, reaching within ``door_near_m`` of the label."""
+    run of mapped free cells (``free``, the grid's :meth:`~sim.mapping.occupancy.OccupancyGrid.free_mask`) along
+    the wall's mid-line, ``wall_line_m`` behind the label, at least ``door_min_m`` and at most ``door_width_m``
+    long, reaching within ``door_near_m`` of the label."""
     along = np.arange(-params.door_near_m - params.door_width_m, params.door_near_m + params.door_width_m + 1e-9,
                       grid.resolution / 2)
     normal = np.array([math.cos(facing), math.sin(facing)])
@@ -63,9 +65,9 @@ def doorway_beside(grid: OccupancyGrid, label_xy: np.ndarray, facing: float, par
     cells = grid.world_to_cell(points)
     rows, cols = grid.shape
     on = (cells[:, 0] >= 0) & (cells[:, 0] < rows) & (cells[:, 1] >= 0) & (cells[:, 1] < cols)
-    free = np.zeros(len(along), dtype=bool)
-    free[on] = grid.free_mask()[cells[on, 0], cells[on, 1]]
-    parts, count = ndimage.label(free)
+    gap = np.zeros(len(along), dtype=bool)
+    gap[on] = free[cells[on, 0], cells[on, 1]]
+    parts, count = ndimage.label(gap)
     for k in range(1, count + 1):
         run = along[parts == k]
         length = run[-1] - run[0] + grid.resolution
@@ -74,13 +76,14 @@ def doorway_beside(grid: OccupancyGrid, label_xy: np.ndarray, facing: float, par
     return False
 
 
-def behind_door(grid: OccupancyGrid, label_xy: tuple[float, float], facing: float, clearance_m: np.ndarray,
-                params: RoomParams = RoomParams()) -> np.ndarray | None:
+def behind_door(grid: OccupancyGrid, label_xy: tuple[float, float], facing: float, clearance: np.ndarray,
+                free: np.ndarray, params: RoomParams = RoomParams()) -> np.ndarray | None:
     """Bool per grid cell: the room behind the door beside the label at ``label_xy`` (m) facing ``facing``
-    (rad), or None when no doorway is mapped beside it (:func:`doorway_beside`). ``clearance_m``: per cell,
-    the distance (m) to the nearest mapped wall, exact up to half ``door_width_m``."""
+    (rad), or None when no doorway is mapped beside it (:func:`doorway_beside`). ``clearance``: per cell, the
+    distance (m) to the nearest mapped wall, exact up to half ``door_width_m``
+    (:func:`sim.navigation.planner.clearance_m`); ``free``: the grid's mapped free cells."""
     label = np.asarray(label_xy, dtype=float)
-    if not doorway_beside(grid, label, facing, params):
+    if not doorway_beside(grid, free, label, facing, params):
         return None
     res, (rows, cols) = grid.resolution, grid.shape
     reach = int(math.ceil(params.reach_m / res)) + 1
@@ -94,7 +97,7 @@ def behind_door(grid: OccupancyGrid, label_xy: tuple[float, float], facing: floa
     d = xy - label
     ahead = d[..., 0] * math.cos(facing) + d[..., 1] * math.sin(facing)
     inside = (ahead < -params.wall_line_m) & (np.hypot(d[..., 0], d[..., 1]) <= params.reach_m)
-    core = inside & (clearance_m[r0:r1, c0:c1] >= params.door_width_m / 2)  # open space no doorway lets through
+    core = inside & (clearance[r0:r1, c0:c1] >= params.door_width_m / 2)  # open space no doorway lets through
     parts, _ = ndimage.label(core, structure=np.ones((3, 3)))
     seed = label - params.behind_m * np.array([math.cos(facing), math.sin(facing)])
     near = (parts > 0) & (np.hypot(xy[..., 0] - seed[0], xy[..., 1] - seed[1]) <= params.door_near_m)
@@ -117,12 +120,11 @@ def other_rooms_likelihood(grid: OccupancyGrid, labels: Iterable[tuple[tuple[flo
     labels = list(labels)
     if not labels:
         return None
-    cap = int(math.ceil(params.door_width_m / 2 / grid.resolution)) + 1
-    clearance = distance_to_occupied(grid.occupied_mask(), cap).astype(float) * grid.resolution
+    clearance, free = clearance_m(grid, params.door_width_m / 2), grid.free_mask()
     out = np.ones(grid.shape)
     found = False
     for xy, facing in labels:
-        room = behind_door(grid, xy, facing, clearance, params)
+        room = behind_door(grid, xy, facing, clearance, free, params)
         if room is not None:
             out[room] = params.other_suite_prob
             found = True

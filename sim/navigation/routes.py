@@ -51,7 +51,7 @@ from scipy import ndimage
 from skimage.graph import MCP_Geometric
 
 from sim.mapping.occupancy import OccupancyGrid, pool_cells, unpool_cells
-from sim.navigation.planner import distance_to_occupied
+from sim.navigation.planner import clearance_m
 
 
 @dataclass(frozen=True)
@@ -356,9 +356,7 @@ def door_depth_weight(grid: OccupancyGrid, start_xy: np.ndarray, params: RoutePa
     searches = PathSearches() if searches is None else searches
     pool = max(1, params.depth_pool)
     res = grid.resolution * pool
-    # Clearance (m) exact up to just past what is asked of it (the robot's radius, half a door), inf beyond.
-    cap = int(math.ceil(max(params.robot_radius_m, params.door_width_m / 2) / grid.resolution)) + 1
-    clearance = distance_to_occupied(grid.occupied_mask(), cap).astype(float) * grid.resolution
+    clearance = clearance_m(grid, max(params.robot_radius_m, params.door_width_m / 2))  # passable, and narrow
     coarse = pool_cells(clearance, pool, 0.0, np.min)  # off the grid counts as wall
     passable = coarse > params.robot_radius_m
     narrow = coarse < params.door_width_m / 2

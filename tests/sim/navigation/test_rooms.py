@@ -51,7 +51,7 @@ def test_the_room_behind_a_labelled_door_is_found_and_nothing_else():
 
 def test_unseen_room_behind_a_mapped_door_counts_out_to_the_reach():
     grid = plan(room_mapped=False)
-    room = behind_door(grid, *LABEL, np.full(grid.shape, np.inf))
+    room = behind_door(grid, *LABEL, np.full(grid.shape, np.inf), grid.free_mask())
     assert room is not None
     assert room[at(grid, (8.0, 5.0))] and room[at(grid, (13.0, 4.0))]  # unseen: as far as the reach
     assert not room[at(grid, (8.0, 1.0))] and not room[at(grid, (8.0, 11.5))]  # the corridor; past the reach
